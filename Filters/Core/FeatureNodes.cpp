@@ -1,0 +1,832 @@
+#include "FeatureNodes.h"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+namespace featuremesh
+{
+namespace
+{
+// Fixed block count for reductions, so that results never depend on the thread count.
+constexpr std::int64_t ReductionBlocks = 64;
+
+using Clock = std::chrono::steady_clock;
+double SecondsSince(Clock::time_point t0)
+{
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Central difference along one axis with one-sided differences on the border.
+inline float Diff(const float* f, std::int64_t idx, int coord, int dim, std::int64_t stride)
+{
+  if (dim < 2)
+  {
+    return 0.f;
+  }
+  if (coord == 0)
+  {
+    return f[idx + stride] - f[idx];
+  }
+  if (coord == dim - 1)
+  {
+    return f[idx] - f[idx - stride];
+  }
+  return 0.5f * (f[idx + stride] - f[idx - stride]);
+}
+
+inline void Coordinates(const Grid& g, std::int64_t idx, int& i, int& j, int& k)
+{
+  const std::int64_t slice = g.SliceStride();
+  k = static_cast<int>(idx / slice);
+  const std::int64_t r = idx - k * slice;
+  j = static_cast<int>(r / g.Dims[0]);
+  i = static_cast<int>(r - static_cast<std::int64_t>(j) * g.Dims[0]);
+}
+
+// True when some voxel within the centred box of half-width h around (i,j,k) is set in mask.
+bool AnyInBox(const std::vector<std::uint8_t>& mask, const Grid& g, int i, int j, int k, int h)
+{
+  const int k0 = std::max(0, k - h), k1 = std::min(g.Dims[2] - 1, k + h);
+  const int j0 = std::max(0, j - h), j1 = std::min(g.Dims[1] - 1, j + h);
+  const int i0 = std::max(0, i - h), i1 = std::min(g.Dims[0] - 1, i + h);
+  for (int kk = k0; kk <= k1; ++kk)
+  {
+    for (int jj = j0; jj <= j1; ++jj)
+    {
+      const std::uint8_t* row = mask.data() + g.Index(0, jj, kk);
+      for (int ii = i0; ii <= i1; ++ii)
+      {
+        if (row[ii])
+        {
+          return true;
+        }
+      }
+    }
+  }
+  return false;
+}
+
+// Evenly spaced positions 0..last with gaps of at most `spacing`.
+std::vector<int> EvenPositions(int extent, int spacing)
+{
+  std::vector<int> pos;
+  if (extent <= 1)
+  {
+    pos.push_back(0);
+    return pos;
+  }
+  const int last = extent - 1;
+  const int segments = std::max(1, (last + spacing - 1) / spacing);
+  for (int s = 0; s <= segments; ++s)
+  {
+    pos.push_back(static_cast<int>(std::lround(static_cast<double>(s) * last / segments)));
+  }
+  return pos;
+}
+} // namespace
+
+std::string ValidateParameters(const FeatureNodeParameters& p)
+{
+  if (!(p.LowThreshold >= 0.0) || !(p.HighThreshold > 0.0))
+  {
+    return "Canny thresholds must be non-negative and the high threshold positive.";
+  }
+  if (p.LowThreshold > p.HighThreshold)
+  {
+    return "the low Canny threshold is above the high one; they are out of order.";
+  }
+  if (!(p.MaximumPercentile > 0.0 && p.MaximumPercentile <= 100.0))
+  {
+    return "the gradient maximum percentile must lie in (0, 100].";
+  }
+  if (p.CovarianceNeighbourhood < 0 || p.CovarianceNeighbourhood > 41)
+  {
+    return "the covariance neighbourhood must be 0 (automatic) or an edge length up to 41 voxels.";
+  }
+  if (!(p.StraightRatio > 0.0 && p.StraightRatio <= p.CurvedRatio && p.CurvedRatio <= 1.0))
+  {
+    return "eigenvalue-ratio thresholds must satisfy 0 < straight <= curved <= 1.";
+  }
+  for (int r : { p.Radii2D[0], p.Radii2D[1], p.Radii2D[2], p.Radii3D[0], p.Radii3D[1], p.Radii3D[2] })
+  {
+    if (r < 0 || r > 50)
+    {
+      return "sampling radii must lie between 0 and 50 voxels.";
+    }
+  }
+  if (!(p.FeaturePercentile > 0.0 && p.FeaturePercentile <= 100.0))
+  {
+    return "the feature-map maximum percentile must lie in (0, 100].";
+  }
+  if (!(p.HalftoneThreshold > 0.0 && p.HalftoneThreshold < 1.0))
+  {
+    return "the halftone threshold q must lie in (0, 1).";
+  }
+  if (!(p.HalftoneGamma > 0.0 && p.HalftoneGamma <= 10.0))
+  {
+    return "the halftone exponent gamma must lie in (0, 10].";
+  }
+  if (p.ExclusionWindow < 1 || p.ExclusionWindow > 101)
+  {
+    return "the exclusion window must be between 1 and 101 voxels.";
+  }
+  if (p.UniformSpacing < 1 || p.BoundarySpacing < 1)
+  {
+    return "uniform and boundary spacings must be at least one voxel.";
+  }
+  return std::string();
+}
+
+void GaussianSmooth(const float* in, float* out, const Grid& g, double sigma, const ParallelFor& parallel)
+{
+  const std::int64_t n = g.Size();
+  if (sigma <= 0.0)
+  {
+    std::copy(in, in + n, out);
+    return;
+  }
+  const int r = std::max(1, static_cast<int>(std::ceil(3.0 * sigma)));
+  std::vector<float> w(2 * r + 1);
+  double sum = 0.0;
+  for (int t = -r; t <= r; ++t)
+  {
+    sum += w[t + r] = static_cast<float>(std::exp(-0.5 * t * t / (sigma * sigma)));
+  }
+  for (float& v : w)
+  {
+    v = static_cast<float>(v / sum);
+  }
+  const int nx = g.Dims[0], ny = g.Dims[1], nz = g.Dims[2];
+  const std::int64_t rows = static_cast<std::int64_t>(ny) * nz;
+  std::vector<float> tmp(n);
+  // x: along each row, with a padded copy of the row.
+  parallel(rows, 64, [&](std::int64_t r0, std::int64_t r1) {
+    std::vector<float> pad(nx + 2 * r);
+    for (std::int64_t row = r0; row < r1; ++row)
+    {
+      const float* src = in + row * nx;
+      for (int i = 0; i < nx + 2 * r; ++i)
+      {
+        pad[i] = src[std::min(nx - 1, std::max(0, i - r))];
+      }
+      float* dst = tmp.data() + row * nx;
+      for (int i = 0; i < nx; ++i)
+      {
+        float acc = 0.f;
+        for (int t = 0; t <= 2 * r; ++t)
+        {
+          acc += w[t] * pad[i + t];
+        }
+        dst[i] = acc;
+      }
+    }
+  });
+  // y and z: whole rows weighted and added, so the inner loop runs along contiguous memory.
+  auto axis = [&](const float* src, float* dst, bool alongZ) {
+    parallel(rows, 16, [&](std::int64_t r0, std::int64_t r1) {
+      for (std::int64_t row = r0; row < r1; ++row)
+      {
+        const int j = static_cast<int>(row % ny), k = static_cast<int>(row / ny);
+        float* o = dst + row * nx;
+        std::fill(o, o + nx, 0.f);
+        for (int t = -r; t <= r; ++t)
+        {
+          const int jj = alongZ ? j : std::min(ny - 1, std::max(0, j + t));
+          const int kk = alongZ ? std::min(nz - 1, std::max(0, k + t)) : k;
+          const float* s = src + g.Index(0, jj, kk);
+          const float wt = w[t + r];
+          for (int i = 0; i < nx; ++i)
+          {
+            o[i] += wt * s[i];
+          }
+        }
+      }
+    });
+  };
+  if (nz > 1)
+  {
+    axis(tmp.data(), out, false);
+    std::copy(out, out + n, tmp.data());
+    axis(tmp.data(), out, true);
+  }
+  else
+  {
+    axis(tmp.data(), out, false);
+  }
+}
+
+void GradientMagnitude(const float* f, const Grid& g, float* magnitude, const ParallelFor& parallel)
+{
+  const std::int64_t sx = 1, sy = g.Dims[0], sz = g.SliceStride();
+  const std::int64_t rows = static_cast<std::int64_t>(g.Dims[1]) * g.Dims[2];
+  parallel(rows, 16, [&](std::int64_t r0, std::int64_t r1) {
+    for (std::int64_t r = r0; r < r1; ++r)
+    {
+      const int j = static_cast<int>(r % g.Dims[1]);
+      const int k = static_cast<int>(r / g.Dims[1]);
+      std::int64_t idx = g.Index(0, j, k);
+      for (int i = 0; i < g.Dims[0]; ++i, ++idx)
+      {
+        const float gx = Diff(f, idx, i, g.Dims[0], sx);
+        const float gy = Diff(f, idx, j, g.Dims[1], sy);
+        const float gz = Diff(f, idx, k, g.Dims[2], sz);
+        magnitude[idx] = std::sqrt(gx * gx + gy * gy + gz * gz);
+      }
+    }
+  });
+}
+
+double RobustMaximum(const float* v, std::int64_t n, double percentile, const ParallelFor& parallel)
+{
+  if (n <= 0)
+  {
+    return 0.0;
+  }
+  const std::int64_t block = (n + ReductionBlocks - 1) / ReductionBlocks;
+  std::vector<float> blockMax(ReductionBlocks, 0.f);
+  parallel(ReductionBlocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+    for (std::int64_t b = b0; b < b1; ++b)
+    {
+      float m = 0.f;
+      for (std::int64_t i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
+      {
+        m = std::max(m, v[i]);
+      }
+      blockMax[b] = m;
+    }
+  });
+  const double maximum = *std::max_element(blockMax.begin(), blockMax.end());
+  if (percentile >= 100.0 || maximum <= 0.0)
+  {
+    return maximum;
+  }
+  constexpr int bins = 4096;
+  std::vector<std::int64_t> hist(static_cast<size_t>(ReductionBlocks) * bins, 0);
+  const double scale = bins / maximum;
+  parallel(ReductionBlocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+    for (std::int64_t b = b0; b < b1; ++b)
+    {
+      std::int64_t* h = hist.data() + b * bins;
+      for (std::int64_t i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
+      {
+        h[std::min(bins - 1, static_cast<int>(v[i] * scale))]++;
+      }
+    }
+  });
+  std::vector<std::int64_t> total(bins, 0);
+  for (std::int64_t b = 0; b < ReductionBlocks; ++b)
+  {
+    for (int i = 0; i < bins; ++i)
+    {
+      total[i] += hist[b * bins + i];
+    }
+  }
+  const double target = percentile / 100.0 * static_cast<double>(n);
+  std::int64_t cumulative = 0;
+  for (int i = 0; i < bins; ++i)
+  {
+    cumulative += total[i];
+    if (static_cast<double>(cumulative) >= target)
+    {
+      // Upper edge of the bin: a percentile falling in the zero bin of a mostly flat image
+      // still gives a positive maximum.
+      return std::min(maximum, (i + 1) / scale);
+    }
+  }
+  return maximum;
+}
+
+std::vector<std::uint8_t> CannyEdges(const float* f, const Grid& g, double low, double high, double percentile,
+  const ParallelFor& parallel, double* gradientMaximum)
+{
+  const std::int64_t n = g.Size();
+  std::vector<float> mag(n);
+  GradientMagnitude(f, g, mag.data(), parallel);
+  const double gmax = RobustMaximum(mag.data(), n, percentile, parallel);
+  if (gradientMaximum)
+  {
+    *gradientMaximum = gmax;
+  }
+  std::vector<std::uint8_t> state(n, 0); // 0 none, 1 weak candidate, 2 strong
+  if (gmax <= 0.0)
+  {
+    return state;
+  }
+  const float lowValue = static_cast<float>(low * gmax);
+  const float highValue = static_cast<float>(high * gmax);
+  const std::int64_t sy = g.Dims[0], sz = g.SliceStride();
+  const std::int64_t rows = static_cast<std::int64_t>(g.Dims[1]) * g.Dims[2];
+  // A quantised direction component is kept when it is at least tan(22.5 deg) of the largest one.
+  constexpr float tan22 = 0.41421356f;
+
+  // Non-maximum suppression along the quantised gradient direction; ties resolved by ">" on one
+  // side and ">=" on the other, so a two-voxel plateau keeps exactly one voxel.
+  parallel(rows, 16, [&](std::int64_t r0, std::int64_t r1) {
+    for (std::int64_t r = r0; r < r1; ++r)
+    {
+      const int j = static_cast<int>(r % g.Dims[1]);
+      const int k = static_cast<int>(r / g.Dims[1]);
+      std::int64_t idx = g.Index(0, j, k);
+      for (int i = 0; i < g.Dims[0]; ++i, ++idx)
+      {
+        const float m = mag[idx];
+        if (m < lowValue || m <= 0.f)
+        {
+          continue;
+        }
+        const float gx = Diff(f, idx, i, g.Dims[0], 1);
+        const float gy = Diff(f, idx, j, g.Dims[1], sy);
+        const float gz = Diff(f, idx, k, g.Dims[2], sz);
+        const float amax = std::max(std::fabs(gx), std::max(std::fabs(gy), std::fabs(gz)));
+        const int dx = std::fabs(gx) >= tan22 * amax ? (gx > 0 ? 1 : -1) : 0;
+        const int dy = std::fabs(gy) >= tan22 * amax ? (gy > 0 ? 1 : -1) : 0;
+        const int dz = std::fabs(gz) >= tan22 * amax ? (gz > 0 ? 1 : -1) : 0;
+        float ahead = 0.f, behind = 0.f;
+        if (g.Contains(i + dx, j + dy, k + dz))
+        {
+          ahead = mag[g.Index(i + dx, j + dy, k + dz)];
+        }
+        if (g.Contains(i - dx, j - dy, k - dz))
+        {
+          behind = mag[g.Index(i - dx, j - dy, k - dz)];
+        }
+        if (m > ahead && m >= behind)
+        {
+          state[idx] = m >= highValue ? 2 : 1;
+        }
+      }
+    }
+  });
+
+  // Hysteresis: grow the strong voxels through connected weak ones.
+  std::vector<std::uint8_t> edges(n, 0);
+  std::vector<std::int64_t> stack;
+  const int kr = g.Is2D() ? 0 : 1;
+  for (std::int64_t s = 0; s < n; ++s)
+  {
+    if (state[s] != 2 || edges[s])
+    {
+      continue;
+    }
+    edges[s] = 1;
+    stack.push_back(s);
+    while (!stack.empty())
+    {
+      const std::int64_t c = stack.back();
+      stack.pop_back();
+      int i, j, k;
+      Coordinates(g, c, i, j, k);
+      for (int dk = -kr; dk <= kr; ++dk)
+      {
+        for (int dj = -1; dj <= 1; ++dj)
+        {
+          for (int di = -1; di <= 1; ++di)
+          {
+            if (!g.Contains(i + di, j + dj, k + dk))
+            {
+              continue;
+            }
+            const std::int64_t q = g.Index(i + di, j + dj, k + dk);
+            if (state[q] && !edges[q])
+            {
+              edges[q] = 1;
+              stack.push_back(q);
+            }
+          }
+        }
+      }
+    }
+  }
+  return edges;
+}
+
+std::vector<std::uint8_t> EdgeSampleRadii(const std::vector<std::int64_t>& pts,
+  const std::vector<std::uint8_t>& edgeMap, const Grid& g, const FeatureNodeParameters& p,
+  const ParallelFor& parallel)
+{
+  const bool is2D = g.Is2D();
+  const int window = p.CovarianceNeighbourhood > 0 ? p.CovarianceNeighbourhood : (is2D ? 11 : 5);
+  const int h = window / 2;
+  const std::array<int, 3>& radii = is2D ? p.Radii2D : p.Radii3D;
+  std::vector<std::uint8_t> result(pts.size());
+  parallel(static_cast<std::int64_t>(pts.size()), 256, [&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t t = b; t < e; ++t)
+    {
+      int i, j, k;
+      Coordinates(g, pts[t], i, j, k);
+      // Moments relative to the centre point keep the sums small and exact in double.
+      double s[3] = { 0, 0, 0 }, ss[6] = { 0, 0, 0, 0, 0, 0 };
+      int count = 0;
+      const int k0 = std::max(0, k - h), k1 = std::min(g.Dims[2] - 1, k + h);
+      const int j0 = std::max(0, j - h), j1 = std::min(g.Dims[1] - 1, j + h);
+      const int i0 = std::max(0, i - h), i1 = std::min(g.Dims[0] - 1, i + h);
+      for (int kk = k0; kk <= k1; ++kk)
+      {
+        for (int jj = j0; jj <= j1; ++jj)
+        {
+          const std::uint8_t* row = edgeMap.data() + g.Index(0, jj, kk);
+          for (int ii = i0; ii <= i1; ++ii)
+          {
+            if (!row[ii])
+            {
+              continue;
+            }
+            const double x = ii - i, y = jj - j, z = kk - k;
+            s[0] += x;
+            s[1] += y;
+            s[2] += z;
+            ss[0] += x * x;
+            ss[1] += y * y;
+            ss[2] += z * z;
+            ss[3] += x * y;
+            ss[4] += x * z;
+            ss[5] += y * z;
+            ++count;
+          }
+        }
+      }
+      int cls = 2; // curved, corner or speck: densest sampling
+      if (count > g.Dimension())
+      {
+        const double c = count;
+        Eigen::Matrix3d cov;
+        cov(0, 0) = ss[0] / c - s[0] * s[0] / (c * c);
+        cov(1, 1) = ss[1] / c - s[1] * s[1] / (c * c);
+        cov(2, 2) = ss[2] / c - s[2] * s[2] / (c * c);
+        cov(0, 1) = cov(1, 0) = ss[3] / c - s[0] * s[1] / (c * c);
+        cov(0, 2) = cov(2, 0) = ss[4] / c - s[0] * s[2] / (c * c);
+        cov(1, 2) = cov(2, 1) = ss[5] / c - s[1] * s[2] / (c * c);
+        double ratio = 1.0;
+        if (is2D)
+        {
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;
+          es.computeDirect(cov.topLeftCorner<2, 2>(), Eigen::EigenvaluesOnly);
+          const double l1 = es.eigenvalues()(1), l2 = std::max(0.0, es.eigenvalues()(0));
+          ratio = l1 > 1e-12 ? l2 / l1 : 1.0;
+        }
+        else
+        {
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+          es.computeDirect(cov, Eigen::EigenvaluesOnly);
+          const double l1 = es.eigenvalues()(2), l3 = std::max(0.0, es.eigenvalues()(0));
+          ratio = l1 > 1e-12 ? l3 / l1 : 1.0;
+        }
+        cls = ratio < p.StraightRatio ? 0 : (ratio < p.CurvedRatio ? 1 : 2);
+      }
+      result[t] = static_cast<std::uint8_t>(radii[cls]);
+    }
+  });
+  return result;
+}
+
+std::vector<std::int64_t> ThinEdgePoints(
+  const std::vector<std::int64_t>& pts, const std::vector<std::uint8_t>& radii, const Grid& g)
+{
+  std::vector<std::int64_t> order(pts.size());
+  std::iota(order.begin(), order.end(), 0);
+  // Densely sampled (curved) points first, so that straight runs give way to corners.
+  std::stable_sort(order.begin(), order.end(),
+    [&](std::int64_t a, std::int64_t b) { return radii[a] < radii[b]; });
+
+  // Bucket grid of kept points, so that a query looks at a few cells instead of a (2R+1)^3 box.
+  constexpr int cell = 4;
+  const int cx = (g.Dims[0] + cell - 1) / cell, cy = (g.Dims[1] + cell - 1) / cell,
+            cz = (g.Dims[2] + cell - 1) / cell;
+  std::vector<std::int64_t> head(static_cast<size_t>(cx) * cy * cz, -1);
+  std::vector<std::int64_t> next;
+  std::vector<std::array<int, 3>> keptPos;
+  std::vector<std::int64_t> kept;
+  for (std::int64_t t : order)
+  {
+    int i, j, k;
+    Coordinates(g, pts[t], i, j, k);
+    const int r = radii[t];
+    bool blocked = false;
+    for (int bz = std::max(0, (k - r) / cell); !blocked && bz <= std::min(cz - 1, (k + r) / cell); ++bz)
+    {
+      for (int by = std::max(0, (j - r) / cell); !blocked && by <= std::min(cy - 1, (j + r) / cell); ++by)
+      {
+        for (int bx = std::max(0, (i - r) / cell); !blocked && bx <= std::min(cx - 1, (i + r) / cell); ++bx)
+        {
+          for (std::int64_t q = head[(static_cast<size_t>(bz) * cy + by) * cx + bx]; q >= 0; q = next[q])
+          {
+            const auto& o = keptPos[q];
+            if (std::abs(o[0] - i) <= r && std::abs(o[1] - j) <= r && std::abs(o[2] - k) <= r)
+            {
+              blocked = true;
+              break;
+            }
+          }
+        }
+      }
+    }
+    if (blocked)
+    {
+      continue;
+    }
+    const size_t c = (static_cast<size_t>(k / cell) * cy + j / cell) * cx + i / cell;
+    next.push_back(head[c]);
+    head[c] = static_cast<std::int64_t>(keptPos.size());
+    keptPos.push_back({ { i, j, k } });
+    kept.push_back(t);
+  }
+  return kept;
+}
+
+std::vector<float> HessianFeatureMap(const float* f, const Grid& g, double gamma, double percentile,
+  const ParallelFor& parallel, double* featureMaximum)
+{
+  const std::int64_t n = g.Size();
+  std::vector<float> rho(n, 0.f);
+  const std::int64_t sy = g.Dims[0], sz = g.SliceStride();
+  const std::int64_t rows = static_cast<std::int64_t>(g.Dims[1]) * g.Dims[2];
+  const bool is2D = g.Is2D();
+  // Second differences need one voxel on each side: the border keeps rho = 0.
+  parallel(rows, 16, [&](std::int64_t r0, std::int64_t r1) {
+    for (std::int64_t r = r0; r < r1; ++r)
+    {
+      const int j = static_cast<int>(r % g.Dims[1]);
+      const int k = static_cast<int>(r / g.Dims[1]);
+      if (j == 0 || j == g.Dims[1] - 1 || (!is2D && (k == 0 || k == g.Dims[2] - 1)))
+      {
+        continue;
+      }
+      for (int i = 1; i < g.Dims[0] - 1; ++i)
+      {
+        const std::int64_t c = g.Index(i, j, k);
+        const float v2 = 2.f * f[c];
+        const float hxx = f[c + 1] - v2 + f[c - 1];
+        const float hyy = f[c + sy] - v2 + f[c - sy];
+        const float hxy = 0.25f * (f[c + 1 + sy] - f[c + 1 - sy] - f[c - 1 + sy] + f[c - 1 - sy]);
+        float norm = 0.f;
+        if (is2D)
+        {
+          const float mean = 0.5f * (hxx + hyy);
+          const float d = std::sqrt(0.25f * (hxx - hyy) * (hxx - hyy) + hxy * hxy);
+          norm = std::fabs(mean) + d; // max(|mean+d|, |mean-d|)
+        }
+        else
+        {
+          const float hzz = f[c + sz] - v2 + f[c - sz];
+          const float hxz = 0.25f * (f[c + 1 + sz] - f[c + 1 - sz] - f[c - 1 + sz] + f[c - 1 - sz]);
+          const float hyz = 0.25f * (f[c + sy + sz] - f[c + sy - sz] - f[c - sy + sz] + f[c - sy - sz]);
+          // Flat regions (e.g. the zero background of skull-stripped MR) skip the eigen-solve.
+          if (hxx != 0.f || hyy != 0.f || hzz != 0.f || hxy != 0.f || hxz != 0.f || hyz != 0.f)
+          {
+            Eigen::Matrix3f h;
+            h << hxx, hxy, hxz, hxy, hyy, hyz, hxz, hyz, hzz;
+            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> es;
+            es.computeDirect(h, Eigen::EigenvaluesOnly);
+            norm = std::max(std::fabs(es.eigenvalues()(0)), std::fabs(es.eigenvalues()(2)));
+          }
+        }
+        rho[c] = std::isfinite(norm) ? norm : 0.f;
+      }
+    }
+  });
+  const double a = RobustMaximum(rho.data(), n, percentile, parallel);
+  if (featureMaximum)
+  {
+    *featureMaximum = a;
+  }
+  if (a <= 0.0)
+  {
+    std::fill(rho.begin(), rho.end(), 0.f);
+    return rho;
+  }
+  const float inv = static_cast<float>(1.0 / a);
+  const float gam = static_cast<float>(gamma);
+  parallel(n, 65536, [&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t i = b; i < e; ++i)
+    {
+      const float v = std::min(1.f, rho[i] * inv);
+      rho[i] = gam == 1.f ? v : std::pow(v, gam);
+    }
+  });
+  return rho;
+}
+
+std::vector<std::int64_t> Halftone(const std::vector<float>& rho, const Grid& g, double q)
+{
+  std::vector<std::int64_t> dots;
+  const int nx = g.Dims[0], ny = g.Dims[1], nz = g.Dims[2];
+  const float threshold = static_cast<float>(q);
+  const float dot = static_cast<float>(2.0 * q);
+  const bool is2D = g.Is2D();
+  // Error buffers: current slice and next slice, so memory stays two slices, not the volume.
+  const std::int64_t slice = g.SliceStride();
+  std::vector<float> cur(slice, 0.f), nxt(is2D ? 0 : slice, 0.f);
+  const float w = is2D ? 1.f : 0.5f;
+  for (int k = 0; k < nz; ++k)
+  {
+    for (int j = 0; j < ny; ++j)
+    {
+      for (int i = 0; i < nx; ++i)
+      {
+        const std::int64_t s = static_cast<std::int64_t>(j) * nx + i;
+        const float v = rho[k * slice + s] + cur[s];
+        float err = v;
+        if (v >= threshold)
+        {
+          dots.push_back(k * slice + s);
+          err = v - dot;
+        }
+        // Bounded error: saturated regions must not flood their neighbours.
+        err = std::max(-dot, std::min(dot, err));
+        if (i + 1 < nx)
+        {
+          cur[s + 1] += w * err * (7.f / 16.f);
+        }
+        if (j + 1 < ny)
+        {
+          if (i > 0)
+          {
+            cur[s + nx - 1] += w * err * (3.f / 16.f);
+          }
+          cur[s + nx] += w * err * (5.f / 16.f);
+          if (i + 1 < nx)
+          {
+            cur[s + nx + 1] += w * err * (1.f / 16.f);
+          }
+        }
+        if (!is2D && k + 1 < nz)
+        {
+          const float e = 0.5f * err;
+          nxt[s] += e * (6.f / 16.f);
+          const float side = e * (2.5f / 16.f);
+          if (i > 0)
+            nxt[s - 1] += side;
+          if (i + 1 < nx)
+            nxt[s + 1] += side;
+          if (j > 0)
+            nxt[s - nx] += side;
+          if (j + 1 < ny)
+            nxt[s + nx] += side;
+        }
+      }
+    }
+    if (!is2D)
+    {
+      std::swap(cur, nxt);
+      std::fill(nxt.begin(), nxt.end(), 0.f);
+    }
+  }
+  return dots;
+}
+
+FeatureNodeResult ComputeFeatureNodes(const float* f, const float* fh, const std::uint8_t* edgeInput, const Grid& g,
+  const FeatureNodeParameters& p, const ParallelFor& parallel, const ProgressFunction& progress)
+{
+  FeatureNodeResult out;
+  const std::int64_t n = g.Size();
+  const bool is2D = g.Is2D();
+  auto t0 = Clock::now();
+
+  // 1. Edges: Canny, or the supplied edge map.
+  if (edgeInput)
+  {
+    out.EdgeMap.assign(edgeInput, edgeInput + n);
+    for (auto& v : out.EdgeMap)
+    {
+      v = v ? 1 : 0;
+    }
+  }
+  else
+  {
+    out.EdgeMap = CannyEdges(f, g, p.LowThreshold, p.HighThreshold, p.MaximumPercentile, parallel,
+      &out.GradientMaximum);
+  }
+  out.StepSeconds.emplace_back("canny", SecondsSince(t0));
+  if (!progress(0.3))
+  {
+    out.Aborted = true;
+    return out;
+  }
+
+  // 2. PCA-adaptive sampling of the edge points.
+  t0 = Clock::now();
+  std::vector<std::int64_t> edgePoints;
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    if (out.EdgeMap[i])
+    {
+      edgePoints.push_back(i);
+    }
+  }
+  out.EdgeVoxels = static_cast<std::int64_t>(edgePoints.size());
+  const std::vector<std::uint8_t> radii = EdgeSampleRadii(edgePoints, out.EdgeMap, g, p, parallel);
+  const std::vector<std::int64_t> kept = ThinEdgePoints(edgePoints, radii, g);
+  out.StepSeconds.emplace_back("pca sampling", SecondsSince(t0));
+  if (!progress(0.5))
+  {
+    out.Aborted = true;
+    return out;
+  }
+
+  // Node occupancy, one node per voxel: boundary nodes claim first, then Canny, halftone, uniform.
+  std::vector<std::uint8_t> occupied(n, 0);
+  auto add = [&](int i, int j, int k, NodeType type, float radius) {
+    const std::int64_t idx = g.Index(i, j, k);
+    if (occupied[idx])
+    {
+      return;
+    }
+    occupied[idx] = 1;
+    out.Positions.push_back({ { i, j, k } });
+    out.Type.push_back(type);
+    out.Fixed.push_back(type == NodeCanny || type == NodeBoundary ? 1 : 0);
+    out.SampleRadius.push_back(radius);
+    out.Counts[type]++;
+  };
+
+  // 3. Boundary nodes: corners always, evenly spaced along the border (2D) or on the box faces (3D).
+  t0 = Clock::now();
+  {
+    const std::vector<int> px = EvenPositions(g.Dims[0], p.BoundarySpacing);
+    const std::vector<int> py = EvenPositions(g.Dims[1], p.BoundarySpacing);
+    const std::vector<int> pz = EvenPositions(g.Dims[2], p.BoundarySpacing);
+    const float r = 0.5f * p.BoundarySpacing;
+    const int lx = g.Dims[0] - 1, ly = g.Dims[1] - 1, lz = g.Dims[2] - 1;
+    for (int k : pz)
+    {
+      for (int j : py)
+      {
+        for (int i : px)
+        {
+          const bool onFace = i == 0 || i == lx || j == 0 || j == ly || (!is2D && (k == 0 || k == lz));
+          if (onFace)
+          {
+            add(i, j, k, NodeBoundary, r);
+          }
+        }
+      }
+    }
+  }
+  for (std::int64_t t : kept)
+  {
+    int i, j, k;
+    Coordinates(g, edgePoints[t], i, j, k);
+    add(i, j, k, NodeCanny, static_cast<float>(radii[t]));
+  }
+  out.StepSeconds.emplace_back("boundary", SecondsSince(t0));
+
+  // 4. Halftoning points, away from edges.
+  const int h = p.ExclusionWindow / 2;
+  if (p.Halftoning)
+  {
+    t0 = Clock::now();
+    const std::vector<float> rho = HessianFeatureMap(fh ? fh : f, g, p.HalftoneGamma, p.FeaturePercentile, parallel,
+      &out.FeatureMaximum);
+    out.StepSeconds.emplace_back("hessian", SecondsSince(t0));
+    if (!progress(0.8))
+    {
+      out.Aborted = true;
+      return out;
+    }
+    t0 = Clock::now();
+    const std::vector<std::int64_t> dots = Halftone(rho, g, p.HalftoneThreshold);
+    for (std::int64_t d : dots)
+    {
+      int i, j, k;
+      Coordinates(g, d, i, j, k);
+      if (!AnyInBox(out.EdgeMap, g, i, j, k, h))
+      {
+        add(i, j, k, NodeHalftone, static_cast<float>(h));
+      }
+    }
+    out.StepSeconds.emplace_back("halftone", SecondsSince(t0));
+  }
+
+  // 5. Uniform lattice points where no edge voxel and no node lies within the window.
+  t0 = Clock::now();
+  {
+    std::vector<std::uint8_t> busy(occupied);
+    for (std::int64_t i = 0; i < n; ++i)
+    {
+      busy[i] |= out.EdgeMap[i];
+    }
+    const int s = p.UniformSpacing;
+    const int start = s / 2;
+    for (int k = is2D ? 0 : start; k < g.Dims[2]; k += s)
+    {
+      for (int j = start; j < g.Dims[1]; j += s)
+      {
+        for (int i = start; i < g.Dims[0]; i += s)
+        {
+          if (!AnyInBox(busy, g, i, j, k, h))
+          {
+            add(i, j, k, NodeUniform, 0.5f * s);
+          }
+        }
+      }
+    }
+  }
+  out.StepSeconds.emplace_back("uniform", SecondsSince(t0));
+  progress(1.0);
+  return out;
+}
+} // namespace featuremesh

@@ -1,0 +1,156 @@
+#include "vtkFeatureMeshUtilities.h"
+
+#include "vtkAlgorithm.h"
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkPointData.h"
+#include "vtkSMPTools.h"
+#include "vtkType.h"
+
+#include <algorithm>
+
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+namespace featuremesh
+{
+void EnsureThreadedBackend()
+{
+  if (!std::getenv("VTK_SMP_BACKEND_IN_USE") && std::string(vtkSMPTools::GetBackend()) == "Sequential")
+  {
+    vtkSMPTools::SetBackend("STDThread");
+  }
+}
+
+ParallelFor SMPParallelFor()
+{
+  return [](std::int64_t n, std::int64_t grain, const RangeFunction& f) {
+    if (n <= 0)
+    {
+      return;
+    }
+    vtkSMPTools::For(0, static_cast<vtkIdType>(n), static_cast<vtkIdType>(grain),
+      [&f](vtkIdType b, vtkIdType e) { f(b, e); });
+  };
+}
+
+ProgressFunction AlgorithmProgress(vtkAlgorithm* algorithm, double begin, double end)
+{
+  return [=](double t) {
+    algorithm->UpdateProgress(begin + (end - begin) * t);
+    return !algorithm->GetAbortExecute();
+  };
+}
+
+bool ImageGrid(vtkImageData* image, Grid& grid, std::string& error)
+{
+  if (!image || image->GetNumberOfPoints() == 0)
+  {
+    error = "the image is empty.";
+    return false;
+  }
+  int dims[3];
+  image->GetDimensions(dims);
+  if (dims[0] < 2 || dims[1] < 2)
+  {
+    error = "the image is " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
+      std::to_string(dims[2]) +
+      " voxels; FeatureMesh needs at least 2 voxels along x and y (2D images lie in the xy plane).";
+    return false;
+  }
+  grid.Dims = { { dims[0], dims[1], dims[2] } };
+  return true;
+}
+
+bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error)
+{
+  if (!array)
+  {
+    error = "the image has no point scalars to process; choose a point data array.";
+    return false;
+  }
+  if (array->GetNumberOfComponents() != 1)
+  {
+    error = std::string("the array '") + (array->GetName() ? array->GetName() : "") + "' has " +
+      std::to_string(array->GetNumberOfComponents()) +
+      " components; choose a single-component array (e.g. extract a component or compute a magnitude first).";
+    return false;
+  }
+  const vtkIdType n = array->GetNumberOfTuples();
+  values.resize(static_cast<size_t>(n));
+  std::vector<vtkIdType> badPerBlock(64, 0);
+  const vtkIdType block = (n + 63) / 64;
+  auto convert = [&](auto* data) {
+    vtkSMPTools::For(0, 64, 1, [&](vtkIdType b0, vtkIdType b1) {
+      for (vtkIdType b = b0; b < b1; ++b)
+      {
+        for (vtkIdType i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
+        {
+          const double v = static_cast<double>(data[i]);
+          const bool ok = std::isfinite(v);
+          badPerBlock[b] += ok ? 0 : 1;
+          values[i] = ok ? static_cast<float>(v) : 0.f;
+        }
+      }
+    });
+  };
+  switch (array->GetDataType())
+  {
+    vtkTemplateMacro(convert(static_cast<VTK_TT*>(array->GetVoidPointer(0))));
+    default:
+      error = "the array's value type is not supported.";
+      return false;
+  }
+  vtkIdType bad = 0;
+  for (vtkIdType c : badPerBlock)
+  {
+    bad += c;
+  }
+  if (bad)
+  {
+    error = std::string("the array '") + (array->GetName() ? array->GetName() : "") + "' holds " +
+      std::to_string(bad) + " NaN or infinite values; replace them (e.g. with a Calculator) first.";
+    return false;
+  }
+  return true;
+}
+
+vtkDataArray* ChosenArray(vtkImageData* image, vtkDataArray* selected, vtkInformation* arrayInfo, std::string& error)
+{
+  if (selected)
+  {
+    return selected;
+  }
+  const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME()) ? arrayInfo->Get(vtkDataObject::FIELD_NAME()) : nullptr;
+  if (name && *name)
+  {
+    error = std::string("the image has no point array named '") + name + "'.";
+    return nullptr;
+  }
+  vtkDataArray* scalars = image ? image->GetPointData()->GetScalars() : nullptr;
+  if (!scalars)
+  {
+    error = "the image has no point scalars to process; choose a point data array.";
+  }
+  return scalars;
+}
+
+void WorldToIndex(vtkImageData* image, const double world[3], double index[3])
+{
+  image->TransformPhysicalPointToContinuousIndex(world, index);
+  const int* ext = image->GetExtent();
+  for (int a = 0; a < 3; ++a)
+  {
+    index[a] -= ext[2 * a];
+  }
+}
+
+void IndexToWorld(vtkImageData* image, const double index[3], double world[3])
+{
+  const int* ext = image->GetExtent();
+  image->TransformContinuousIndexToPhysicalPoint(
+    index[0] + ext[0], index[1] + ext[2], index[2] + ext[4], world);
+}
+} // namespace featuremesh

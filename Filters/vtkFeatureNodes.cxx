@@ -1,0 +1,275 @@
+#include "vtkFeatureNodes.h"
+
+#include "FeatureNodes.h"
+#include "vtkFeatureMeshUtilities.h"
+
+#include "vtkCellArray.h"
+#include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkIntArray.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkUnsignedCharArray.h"
+
+#include <chrono>
+
+vtkStandardNewMacro(vtkFeatureNodes);
+
+vtkFeatureNodes::vtkFeatureNodes()
+{
+  this->SetNumberOfInputPorts(2);
+  this->SetNumberOfOutputPorts(2);
+  this->SetInputArrayToProcess(
+    0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+}
+
+int vtkFeatureNodes::FillInputPortInformation(int port, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+  if (port == 1)
+  {
+    info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  }
+  return 1;
+}
+
+int vtkFeatureNodes::FillOutputPortInformation(int port, vtkInformation* info)
+{
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), port == 0 ? "vtkPolyData" : "vtkImageData");
+  return 1;
+}
+
+int vtkFeatureNodes::RequestInformation(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  vtkInformation* edgeInfo = outputVector->GetInformationObject(1);
+  int ext[6];
+  double spacing[3], origin[3];
+  inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), ext);
+  inInfo->Get(vtkDataObject::SPACING(), spacing);
+  inInfo->Get(vtkDataObject::ORIGIN(), origin);
+  edgeInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), ext, 6);
+  edgeInfo->Set(vtkDataObject::SPACING(), spacing, 3);
+  edgeInfo->Set(vtkDataObject::ORIGIN(), origin, 3);
+  vtkDataObject::SetPointDataActiveScalarInfo(edgeInfo, VTK_UNSIGNED_CHAR, 1);
+  return 1;
+}
+
+int vtkFeatureNodes::RequestUpdateExtent(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
+{
+  // Every stage needs the whole image: request it, never a piece.
+  for (int port = 0; port < 2; ++port)
+  {
+    for (int c = 0; c < inputVector[port]->GetNumberOfInformationObjects(); ++c)
+    {
+      vtkInformation* info = inputVector[port]->GetInformationObject(c);
+      int ext[6];
+      info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), ext);
+      info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), ext, 6);
+      info->Set(vtkStreamingDemandDrivenPipeline::EXACT_EXTENT(), 1);
+    }
+  }
+  return 1;
+}
+
+int vtkFeatureNodes::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  using namespace featuremesh;
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  EnsureThreadedBackend();
+  vtkImageData* input = vtkImageData::GetData(inputVector[0], 0);
+  vtkImageData* edgeInput = vtkImageData::GetData(inputVector[1], 0);
+  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
+  vtkImageData* edgeOutput = vtkImageData::GetData(outputVector, 1);
+
+  std::string error;
+  Grid grid;
+  if (!ImageGrid(input, grid, error))
+  {
+    vtkErrorMacro("Feature Nodes: " << error);
+    return 0;
+  }
+  if (!(this->GaussianSigma >= 0.0 && this->GaussianSigma <= 50.0) ||
+    !(this->HessianSigma >= 0.0 && this->HessianSigma <= 50.0))
+  {
+    vtkErrorMacro("Feature Nodes: Gaussian and Hessian sigmas must lie in [0, 50] voxels, not "
+      << this->GaussianSigma << " and " << this->HessianSigma << ".");
+    return 0;
+  }
+  FeatureNodeParameters p;
+  p.LowThreshold = this->LowThreshold;
+  p.HighThreshold = this->HighThreshold;
+  p.MaximumPercentile = this->MaximumPercentile;
+  p.CovarianceNeighbourhood = this->CovarianceNeighbourhood;
+  p.Halftoning = this->Halftoning;
+  p.HalftoneThreshold = this->HalftoneThreshold;
+  p.HalftoneGamma = this->HalftoneGamma;
+  p.ExclusionWindow = this->ExclusionWindow;
+  p.UniformSpacing = this->UniformSpacing;
+  p.BoundarySpacing = this->BoundarySpacing;
+  error = ValidateParameters(p);
+  if (!error.empty())
+  {
+    vtkErrorMacro("Feature Nodes: " << error);
+    return 0;
+  }
+
+  std::vector<float> values;
+  vtkDataArray* array =
+    ChosenArray(input, this->GetInputArrayToProcess(0, inputVector), this->GetInputArrayInformation(0), error);
+  if (!array || !ToFloat(array, values, error))
+  {
+    vtkErrorMacro("Feature Nodes: " << error);
+    return 0;
+  }
+
+  std::vector<std::uint8_t> edgeValues;
+  if (edgeInput)
+  {
+    vtkDataArray* edgeArray = edgeInput->GetPointData()->GetScalars();
+    if (!edgeArray && edgeInput->GetPointData()->GetNumberOfArrays() > 0)
+    {
+      edgeArray = edgeInput->GetPointData()->GetArray(0);
+    }
+    int dims[3];
+    edgeInput->GetDimensions(dims);
+    if (!edgeArray || dims[0] != grid.Dims[0] || dims[1] != grid.Dims[1] || dims[2] != grid.Dims[2])
+    {
+      vtkErrorMacro("Feature Nodes: the edge map must be an image with a point array on the same grid as the input ("
+        << grid.Dims[0] << "x" << grid.Dims[1] << "x" << grid.Dims[2] << ").");
+      return 0;
+    }
+    edgeValues.resize(values.size());
+    for (vtkIdType i = 0; i < static_cast<vtkIdType>(values.size()); ++i)
+    {
+      edgeValues[i] = edgeArray->GetComponent(i, 0) != 0.0 ? 1 : 0;
+    }
+  }
+  const double prepSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+  this->UpdateProgress(0.05);
+
+  // Gaussian smoothing at the Canny scale and at the Hessian scale.
+  auto t0 = Clock::now();
+  const ParallelFor parallel = SMPParallelFor();
+  std::vector<float> smoothed(values.size()), hessianSmoothed;
+  GaussianSmooth(values.data(), smoothed.data(), grid, this->GaussianSigma, parallel);
+  if (this->Halftoning && this->HessianSigma != this->GaussianSigma)
+  {
+    hessianSmoothed.resize(values.size());
+    GaussianSmooth(values.data(), hessianSmoothed.data(), grid, this->HessianSigma, parallel);
+  }
+  const double smoothSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  this->UpdateProgress(0.15);
+
+  FeatureNodeResult result = ComputeFeatureNodes(smoothed.data(), hessianSmoothed.empty() ? nullptr : hessianSmoothed.data(), edgeInput ? edgeValues.data() : nullptr, grid, p,
+    parallel, AlgorithmProgress(this, 0.15, 0.95));
+  if (result.Aborted)
+  {
+    return 1;
+  }
+  if (result.EdgeVoxels == 0)
+  {
+    vtkWarningMacro("Feature Nodes: no edges were found (a constant or very smooth image?); "
+                    "the nodes are uniform and boundary nodes only.");
+  }
+
+  // Output 0: nodes at voxel-centre world coordinates.
+  const vtkIdType n = static_cast<vtkIdType>(result.Positions.size());
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  vtkNew<vtkUnsignedCharArray> type, fixed;
+  vtkNew<vtkFloatArray> radius;
+  type->SetName("NodeType");
+  fixed->SetName("Fixed");
+  radius->SetName("SampleRadius");
+  type->SetNumberOfTuples(n);
+  fixed->SetNumberOfTuples(n);
+  radius->SetNumberOfTuples(n);
+  vtkNew<vtkCellArray> verts;
+  verts->AllocateExact(n, n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    const auto& ijk = result.Positions[i];
+    const double index[3] = { double(ijk[0]), double(ijk[1]), double(ijk[2]) };
+    double world[3];
+    IndexToWorld(input, index, world);
+    points->SetPoint(i, world);
+    type->SetValue(i, result.Type[i]);
+    fixed->SetValue(i, result.Fixed[i]);
+    radius->SetValue(i, result.SampleRadius[i]);
+    verts->InsertNextCell(1, &i);
+  }
+  output->SetPoints(points);
+  output->SetVerts(verts);
+  output->GetPointData()->AddArray(type);
+  output->GetPointData()->AddArray(fixed);
+  output->GetPointData()->AddArray(radius);
+  output->GetPointData()->SetActiveScalars("NodeType");
+
+  vtkNew<vtkIntArray> counts;
+  counts->SetName("NodeCounts");
+  counts->SetNumberOfComponents(4);
+  counts->SetComponentName(0, "Canny");
+  counts->SetComponentName(1, "Halftone");
+  counts->SetComponentName(2, "Uniform");
+  counts->SetComponentName(3, "Boundary");
+  counts->InsertNextTuple4(result.Counts[0], result.Counts[1], result.Counts[2], result.Counts[3]);
+  output->GetFieldData()->AddArray(counts);
+  vtkNew<vtkDoubleArray> timing;
+  timing->SetName("StepSeconds");
+  timing->SetNumberOfComponents(static_cast<int>(result.StepSeconds.size()) + 2);
+  timing->SetComponentName(0, "prepare");
+  timing->SetComponentName(1, "gaussian");
+  std::vector<double> tuple = { prepSeconds, smoothSeconds };
+  for (size_t s = 0; s < result.StepSeconds.size(); ++s)
+  {
+    timing->SetComponentName(static_cast<vtkIdType>(s) + 2, result.StepSeconds[s].first.c_str());
+    tuple.push_back(result.StepSeconds[s].second);
+  }
+  timing->InsertNextTuple(tuple.data());
+  output->GetFieldData()->AddArray(timing);
+
+  // Output 1: the edge map used.
+  edgeOutput->SetExtent(input->GetExtent());
+  edgeOutput->SetSpacing(input->GetSpacing());
+  edgeOutput->SetOrigin(input->GetOrigin());
+  edgeOutput->SetDirectionMatrix(input->GetDirectionMatrix());
+  vtkNew<vtkUnsignedCharArray> edgeArray;
+  edgeArray->SetName("EdgeMap");
+  edgeArray->SetNumberOfTuples(static_cast<vtkIdType>(result.EdgeMap.size()));
+  std::copy(result.EdgeMap.begin(), result.EdgeMap.end(), edgeArray->GetPointer(0));
+  edgeOutput->GetPointData()->SetScalars(edgeArray);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+void vtkFeatureNodes::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "GaussianSigma: " << this->GaussianSigma << "\n";
+ os << indent << "HessianSigma: " << this->HessianSigma << "\n";
+  os << indent << "LowThreshold: " << this->LowThreshold << "\n";
+  os << indent << "HighThreshold: " << this->HighThreshold << "\n";
+  os << indent << "MaximumPercentile: " << this->MaximumPercentile << "\n";
+  os << indent << "CovarianceNeighbourhood: " << this->CovarianceNeighbourhood << "\n";
+  os << indent << "Halftoning: " << this->Halftoning << "\n";
+  os << indent << "HalftoneThreshold: " << this->HalftoneThreshold << "\n";
+  os << indent << "HalftoneGamma: " << this->HalftoneGamma << "\n";
+  os << indent << "ExclusionWindow: " << this->ExclusionWindow << "\n";
+  os << indent << "UniformSpacing: " << this->UniformSpacing << "\n";
+  os << indent << "BoundarySpacing: " << this->BoundarySpacing << "\n";
+}
