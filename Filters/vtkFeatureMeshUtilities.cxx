@@ -4,6 +4,8 @@
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkPointData.h"
 #include "vtkSMPTools.h"
 #include "vtkType.h"
@@ -64,7 +66,26 @@ bool ImageGrid(vtkImageData* image, Grid& grid, std::string& error)
   return true;
 }
 
-bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error)
+void RequestWholeImage(vtkInformationVector* portVector)
+{
+  for (int c = 0; c < portVector->GetNumberOfInformationObjects(); ++c)
+  {
+    vtkInformation* info = portVector->GetInformationObject(c);
+    if (!info->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+    {
+      continue;
+    }
+    int ext[6];
+    info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), ext);
+    info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), ext, 6);
+    info->Set(vtkStreamingDemandDrivenPipeline::EXACT_EXTENT(), 1);
+  }
+}
+
+namespace
+{
+template <typename T>
+bool ToValues(vtkDataArray* array, std::vector<T>& values, std::string& error)
 {
   if (!array)
   {
@@ -91,7 +112,7 @@ bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error
           const double v = static_cast<double>(data[i]);
           const bool ok = std::isfinite(v);
           badPerBlock[b] += ok ? 0 : 1;
-          values[i] = ok ? static_cast<float>(v) : 0.f;
+          values[i] = ok ? static_cast<T>(v) : T(0);
         }
       }
     });
@@ -116,25 +137,37 @@ bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error
   }
   return true;
 }
+} // namespace
 
-vtkDataArray* ChosenArray(vtkImageData* image, vtkDataArray* selected, vtkInformation* arrayInfo, std::string& error)
+bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error)
 {
-  if (selected)
-  {
-    return selected;
-  }
+  return ToValues(array, values, error);
+}
+
+bool ToDouble(vtkDataArray* array, std::vector<double>& values, std::string& error)
+{
+  return ToValues(array, values, error);
+}
+
+vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::string& error)
+{
   const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME()) ? arrayInfo->Get(vtkDataObject::FIELD_NAME()) : nullptr;
+  vtkDataArray* array = nullptr;
   if (name && *name)
   {
-    error = std::string("the image has no point array named '") + name + "'.";
-    return nullptr;
+    array = image->GetPointData()->GetArray(name);
+    if (!array)
+    {
+      error = std::string("the image has no point array named '") + name + "'.";
+    }
+    return array;
   }
-  vtkDataArray* scalars = image ? image->GetPointData()->GetScalars() : nullptr;
-  if (!scalars)
+  array = image->GetPointData()->GetScalars();
+  if (!array)
   {
     error = "the image has no point scalars to process; choose a point data array.";
   }
-  return scalars;
+  return array;
 }
 
 void WorldToIndex(vtkImageData* image, const double world[3], double index[3])

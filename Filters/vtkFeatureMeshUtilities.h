@@ -13,6 +13,7 @@ class vtkAlgorithm;
 class vtkDataArray;
 class vtkImageData;
 class vtkInformation;
+class vtkInformationVector;
 class vtkPointSet;
 
 namespace featuremesh
@@ -31,13 +32,19 @@ ProgressFunction AlgorithmProgress(vtkAlgorithm* algorithm, double begin, double
 // and be a single xy slice (2D) or a volume with at least 2 voxels along z (3D).
 bool ImageGrid(vtkImageData* image, Grid& grid, std::string& error);
 
+// Sets the update extent of every image connected to `port` to its whole extent.
+void RequestWholeImage(vtkInformationVector* portVector);
+
+// Copies a one-component array to double, rejecting NaN/Inf.
+bool ToDouble(vtkDataArray* array, std::vector<double>& values, std::string& error);
+
 // Copies a one-component array to float, rejecting NaN/Inf (error names how many).
 bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error);
 
-// The array chosen with SetInputArrayToProcess, or the active point scalars when no name was
-// given (ParaView sends an empty name when the input had not run yet). Null with an error sentence
-// when a named array is missing.
-vtkDataArray* ChosenArray(vtkImageData* image, vtkDataArray* selected, vtkInformation* arrayInfo, std::string& error);
+// The image point array named by SetInputArrayToProcess (looked up on `image`, whatever port the
+// selection names), or the active point scalars when no name was given (ParaView sends an empty
+// name when the input had not run yet). Null with an error sentence when a named array is missing.
+vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::string& error);
 
 // Index-space coordinates (relative to the extent's start) of a world point.
 void WorldToIndex(vtkImageData* image, const double world[3], double index[3]);

@@ -69,17 +69,8 @@ int vtkFeatureNodes::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
 {
   // Every stage needs the whole image: request it, never a piece.
-  for (int port = 0; port < 2; ++port)
-  {
-    for (int c = 0; c < inputVector[port]->GetNumberOfInformationObjects(); ++c)
-    {
-      vtkInformation* info = inputVector[port]->GetInformationObject(c);
-      int ext[6];
-      info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), ext);
-      info->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), ext, 6);
-      info->Set(vtkStreamingDemandDrivenPipeline::EXACT_EXTENT(), 1);
-    }
-  }
+  featuremesh::RequestWholeImage(inputVector[0]);
+  featuremesh::RequestWholeImage(inputVector[1]);
   return 1;
 }
 
@@ -129,7 +120,7 @@ int vtkFeatureNodes::RequestData(
 
   std::vector<float> values;
   vtkDataArray* array =
-    ChosenArray(input, this->GetInputArrayToProcess(0, inputVector), this->GetInputArrayInformation(0), error);
+    ChosenArray(input, this->GetInputArrayInformation(0), error);
   if (!array || !ToFloat(array, values, error))
   {
     vtkErrorMacro("Feature Nodes: " << error);

@@ -1,0 +1,232 @@
+#include "DelaunayMesh.h"
+
+#include <CGAL/Delaunay_triangulation_2.h>
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include <tetgen.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <numeric>
+#include <utility>
+
+namespace featuremesh
+{
+namespace
+{
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Vb2 = CGAL::Triangulation_vertex_base_with_info_2<std::int64_t, K>;
+using Tds2 = CGAL::Triangulation_data_structure_2<Vb2>;
+using DT2 = CGAL::Delaunay_triangulation_2<K, Tds2>;
+using Vb3 = CGAL::Triangulation_vertex_base_with_info_3<std::int64_t, K>;
+using Tds3 = CGAL::Triangulation_data_structure_3<Vb3>;
+using DT3 = CGAL::Delaunay_triangulation_3<K, Tds3>;
+
+double Orient3(const std::array<double, 3>& a, const std::array<double, 3>& b, const std::array<double, 3>& c,
+  const std::array<double, 3>& d)
+{
+  const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+  const double v[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+  const double w[3] = { d[0] - a[0], d[1] - a[1], d[2] - a[2] };
+  return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+    u[2] * (v[0] * w[1] - v[1] * w[0]);
+}
+
+void OrientTetrahedra(DelaunayResult& r)
+{
+  for (size_t c = 0; c < r.Cells.size(); c += 4)
+  {
+    const auto& P = r.Points;
+    if (Orient3(P[r.Cells[c]], P[r.Cells[c + 1]], P[r.Cells[c + 2]], P[r.Cells[c + 3]]) < 0)
+    {
+      std::swap(r.Cells[c + 2], r.Cells[c + 3]);
+    }
+  }
+}
+
+DelaunayResult TetrahedralizeCGAL(const std::vector<std::array<double, 3>>& points)
+{
+  DelaunayResult r;
+  std::vector<std::pair<K::Point_3, std::int64_t>> input;
+  input.reserve(points.size());
+  for (size_t i = 0; i < points.size(); ++i)
+  {
+    input.emplace_back(K::Point_3(points[i][0], points[i][1], points[i][2]), static_cast<std::int64_t>(i));
+  }
+  DT3 dt(input.begin(), input.end());
+  if (dt.dimension() < 3)
+  {
+    r.Error = "the nodes are coplanar (or collinear); a tetrahedral mesh needs nodes spanning a volume.";
+    return r;
+  }
+  r.Points = points;
+  r.VerticesPerCell = 4;
+  r.Cells.reserve(4 * dt.number_of_finite_cells());
+  for (auto c = dt.finite_cells_begin(); c != dt.finite_cells_end(); ++c)
+  {
+    for (int v = 0; v < 4; ++v)
+    {
+      r.Cells.push_back(c->vertex(v)->info());
+    }
+  }
+  OrientTetrahedra(r);
+  return r;
+}
+
+DelaunayResult TetrahedralizeTetGen(const std::vector<std::array<double, 3>>& points, const DelaunayOptions& o)
+{
+  DelaunayResult r;
+  tetgenio in, out;
+  in.firstnumber = 0;
+  in.numberofpoints = static_cast<int>(points.size());
+  in.pointlist = new REAL[3 * points.size()]; // freed by tetgenio
+  for (size_t i = 0; i < points.size(); ++i)
+  {
+    std::copy(points[i].begin(), points[i].end(), in.pointlist + 3 * i);
+  }
+  // Q quiet, z zero-based; no p: the Delaunay tetrahedralisation of the point set itself.
+  std::string switches = "Qz";
+  if (o.QualityRefinement)
+  {
+    char buffer[64];
+    std::snprintf(buffer, sizeof(buffer), "q%g/%g", o.RadiusEdgeRatio, o.MinDihedralAngle);
+    switches += buffer;
+  }
+  std::vector<char> sw(switches.begin(), switches.end());
+  sw.push_back('\0');
+  try
+  {
+    tetrahedralize(sw.data(), &in, &out);
+  }
+  catch (int code)
+  {
+    r.Error = "TetGen failed (code " + std::to_string(code) +
+      "); the nodes may be degenerate (coplanar, or too close to each other).";
+    return r;
+  }
+  catch (const std::exception& e)
+  {
+    r.Error = std::string("TetGen failed: ") + e.what();
+    return r;
+  }
+  if (out.numberoftetrahedra <= 0 || out.numberofpoints < static_cast<int>(points.size()))
+  {
+    r.Error = "TetGen produced no tetrahedra; the nodes are probably coplanar.";
+    return r;
+  }
+  r.VerticesPerCell = 4;
+  r.Points = points;
+  for (int i = static_cast<int>(points.size()); i < out.numberofpoints; ++i)
+  {
+    r.Points.push_back({ { out.pointlist[3 * i], out.pointlist[3 * i + 1], out.pointlist[3 * i + 2] } });
+  }
+  r.Cells.assign(out.tetrahedronlist, out.tetrahedronlist + 4 * static_cast<size_t>(out.numberoftetrahedra));
+  OrientTetrahedra(r);
+  return r;
+}
+} // namespace
+
+std::int64_t CountDuplicates(const std::vector<std::array<double, 3>>& points)
+{
+  std::vector<std::array<double, 3>> sorted(points);
+  std::sort(sorted.begin(), sorted.end());
+  std::int64_t duplicates = 0;
+  for (size_t i = 1; i < sorted.size(); ++i)
+  {
+    duplicates += sorted[i] == sorted[i - 1] ? 1 : 0;
+  }
+  return duplicates;
+}
+
+DelaunayResult Triangulate2D(const std::vector<std::array<double, 3>>& points)
+{
+  DelaunayResult r;
+  try
+  {
+    std::vector<std::pair<K::Point_2, std::int64_t>> input;
+    input.reserve(points.size());
+    for (size_t i = 0; i < points.size(); ++i)
+    {
+      input.emplace_back(K::Point_2(points[i][0], points[i][1]), static_cast<std::int64_t>(i));
+    }
+    DT2 dt(input.begin(), input.end());
+    if (dt.dimension() < 2)
+    {
+      r.Error = "the nodes are collinear; a triangle mesh needs nodes spanning an area.";
+      return r;
+    }
+    r.Points = points;
+    r.VerticesPerCell = 3;
+    r.Cells.reserve(3 * dt.number_of_faces());
+    // CGAL's finite faces are counter-clockwise.
+    for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f)
+    {
+      for (int v = 0; v < 3; ++v)
+      {
+        r.Cells.push_back(f->vertex(v)->info());
+      }
+    }
+  }
+  catch (const std::exception& e)
+  {
+    r = DelaunayResult();
+    r.Error = std::string("CGAL failed: ") + e.what();
+  }
+  return r;
+}
+
+DelaunayResult Tetrahedralize(const std::vector<std::array<double, 3>>& points, const DelaunayOptions& o)
+{
+  try
+  {
+    // Coplanarity is checked first with CGAL's exact predicates: TetGen on such input is not
+    // guaranteed to fail cleanly.
+    bool spansVolume = false;
+    if (points.size() >= 4)
+    {
+      // First non-coplanar quadruple, found in one pass after fixing a non-collinear triple.
+      const auto& a = points[0];
+      size_t bi = 0, ci = 0;
+      for (size_t i = 1; i < points.size() && !bi; ++i)
+      {
+        if (points[i] != a)
+        {
+          bi = i;
+        }
+      }
+      for (size_t i = bi + 1; bi && i < points.size() && !ci; ++i)
+      {
+        if (!CGAL::collinear(K::Point_3(a[0], a[1], a[2]), K::Point_3(points[bi][0], points[bi][1], points[bi][2]),
+              K::Point_3(points[i][0], points[i][1], points[i][2])))
+        {
+          ci = i;
+        }
+      }
+      for (size_t i = ci + 1; ci && i < points.size() && !spansVolume; ++i)
+      {
+        spansVolume = CGAL::orientation(K::Point_3(a[0], a[1], a[2]),
+                        K::Point_3(points[bi][0], points[bi][1], points[bi][2]),
+                        K::Point_3(points[ci][0], points[ci][1], points[ci][2]),
+                        K::Point_3(points[i][0], points[i][1], points[i][2])) != CGAL::COPLANAR;
+      }
+    }
+    if (!spansVolume)
+    {
+      DelaunayResult r;
+      r.Error = "the nodes are coplanar (or collinear); a tetrahedral mesh needs nodes spanning a volume.";
+      return r;
+    }
+    return o.Backend == DelaunayBackend::CGAL ? TetrahedralizeCGAL(points) : TetrahedralizeTetGen(points, o);
+  }
+  catch (const std::exception& e)
+  {
+    DelaunayResult r;
+    r.Error = std::string("tetrahedralisation failed: ") + e.what();
+    return r;
+  }
+}
+} // namespace featuremesh

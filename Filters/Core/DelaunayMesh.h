@@ -1,0 +1,44 @@
+// Delaunay triangulation (2D, CGAL) and tetrahedralisation (3D, TetGen or CGAL) of mesh nodes.
+// Library failures (TetGen throws, CGAL asserts by exception) come back as an error sentence.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace featuremesh
+{
+enum class DelaunayBackend
+{
+  TetGen = 0,
+  CGAL = 1
+};
+
+struct DelaunayOptions
+{
+  DelaunayBackend Backend = DelaunayBackend::TetGen;
+  // TetGen quality refinement (adds nodes): radius-edge bound and minimum dihedral angle (deg).
+  bool QualityRefinement = false;
+  double RadiusEdgeRatio = 2.0;
+  double MinDihedralAngle = 10.0;
+};
+
+struct DelaunayResult
+{
+  // Input points first, in input order, then any points the mesher added.
+  std::vector<std::array<double, 3>> Points;
+  // 3 (2D) or 4 (3D) point ids per element, positively oriented.
+  std::vector<std::int64_t> Cells;
+  int VerticesPerCell = 0;
+  std::string Error;
+};
+
+// Points are (x, y[, z]); 2D uses x and y only. Positive orientation: counter-clockwise triangles,
+// tetrahedra with det[b-a, c-a, d-a] > 0.
+DelaunayResult Triangulate2D(const std::vector<std::array<double, 3>>& points);
+DelaunayResult Tetrahedralize(const std::vector<std::array<double, 3>>& points, const DelaunayOptions& options);
+
+// Number of points that repeat an earlier point exactly.
+std::int64_t CountDuplicates(const std::vector<std::array<double, 3>>& points);
+} // namespace featuremesh

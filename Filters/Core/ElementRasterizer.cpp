@@ -1,0 +1,260 @@
+#include "ElementRasterizer.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace featuremesh
+{
+ElementRasterizer::ElementRasterizer(const std::vector<std::array<double, 3>>& indexPoints,
+  const std::vector<std::int64_t>& cells, int verticesPerCell, const Grid& grid)
+  : Points(&indexPoints)
+  , Cells(&cells)
+  , Vpc(verticesPerCell)
+  , G(grid)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    this->TwiceCentre[a] = grid.Dims[a] - 1.0;
+  }
+}
+
+bool ElementRasterizer::Owns(const double* plane, int faces, double x, double y, double z) const
+{
+  for (int f = 0; f < faces; ++f)
+  {
+    const double* n = plane + 4 * f;
+    const double lambda = n[0] * x + n[1] * y + n[2] * z + n[3];
+    if (lambda > 0)
+    {
+      continue;
+    }
+    if (lambda < 0)
+    {
+      return false;
+    }
+    // On the face plane: decide by the pull towards the box centre, then lexicographically.
+    const double toCentre = n[0] * (this->TwiceCentre[0] - 2 * x) + n[1] * (this->TwiceCentre[1] - 2 * y) +
+      (faces == 3 ? 0.0 : n[2] * (this->TwiceCentre[2] - 2 * z));
+    if (toCentre < 0)
+    {
+      return false;
+    }
+    if (toCentre == 0)
+    {
+      const bool positive = n[0] > 0 || (n[0] == 0 && (n[1] > 0 || (n[1] == 0 && n[2] > 0)));
+      if (!positive)
+      {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+double InterpolateAt(const double* values, const Grid& g, const double index[3])
+{
+  int base[3];
+  double t[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    const double c = std::min(std::max(index[a], 0.0), static_cast<double>(g.Dims[a] - 1));
+    base[a] = std::min(static_cast<int>(std::floor(c)), std::max(0, g.Dims[a] - 2));
+    t[a] = g.Dims[a] > 1 ? c - base[a] : 0.0;
+  }
+  double result = 0.0;
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    double w = 1.0;
+    int ijk[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      const int bit = (corner >> a) & 1;
+      if (g.Dims[a] == 1 && bit)
+      {
+        w = 0.0;
+      }
+      ijk[a] = std::min(base[a] + bit, g.Dims[a] - 1);
+      w *= bit ? t[a] : 1.0 - t[a];
+    }
+    if (w != 0.0)
+    {
+      result += w * values[g.Index(ijk[0], ijk[1], ijk[2])];
+    }
+  }
+  return result;
+}
+
+ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster,
+  const std::vector<std::array<double, 3>>& P, const std::vector<std::int64_t>& cells, int vpc,
+  const double* values, const Grid& g, const ParallelFor& parallel)
+{
+  const std::int64_t m = raster.NumberOfElements();
+  ElementStatistics s;
+  s.PixelCount.assign(m, 0);
+  s.Mean.assign(m, 0.0);
+  s.StdDev.assign(m, 0.0);
+  s.Interpolated.assign(m, 0);
+  parallel(m, 512, [&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t c = b; c < e; ++c)
+    {
+      // One pass with sums shifted by the element's first value: no cancellation for large,
+      // nearly constant elements, and half the memory traffic of a two-pass variance.
+      std::int64_t count = 0;
+      double shift = 0.0, sum = 0.0, ss = 0.0;
+      raster.ForEachVoxel(c, [&](std::int64_t v) {
+        if (count == 0)
+        {
+          shift = values[v];
+        }
+        ++count;
+        const double d = values[v] - shift;
+        sum += d;
+        ss += d * d;
+      });
+      if (count == 0)
+      {
+        double centroid[3] = { 0, 0, 0 };
+        for (int v = 0; v < vpc; ++v)
+        {
+          for (int a = 0; a < 3; ++a)
+          {
+            centroid[a] += P[cells[c * vpc + v]][a] / vpc;
+          }
+        }
+        s.Mean[c] = InterpolateAt(values, g, centroid);
+        s.Interpolated[c] = 1;
+        continue;
+      }
+      const double meanShifted = sum / static_cast<double>(count);
+      const double mean = shift + meanShifted;
+      ss = std::max(0.0, ss / static_cast<double>(count) - meanShifted * meanShifted);
+      s.PixelCount[c] = count;
+      s.Mean[c] = mean;
+      s.StdDev[c] = std::sqrt(ss);
+    }
+  });
+  return s;
+}
+
+std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const Grid& g, const ParallelFor& parallel)
+{
+  std::vector<std::int64_t> owner(g.Size(), -1);
+  // Each centre has exactly one owner, so the writes never collide.
+  parallel(raster.NumberOfElements(), 512, [&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t c = b; c < e; ++c)
+    {
+      raster.ForEachVoxel(c, [&](std::int64_t v) { owner[v] = c; });
+    }
+  });
+  return owner;
+}
+
+double ElementMeasure(const std::vector<std::array<double, 3>>& P, const std::int64_t* c, int vpc)
+{
+  const auto& a = P[c[0]];
+  const auto& b = P[c[1]];
+  const auto& d = P[c[2]];
+  if (vpc == 3)
+  {
+    return 0.5 * ((b[0] - a[0]) * (d[1] - a[1]) - (b[1] - a[1]) * (d[0] - a[0]));
+  }
+  const auto& e = P[c[3]];
+  const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+  const double v[3] = { d[0] - a[0], d[1] - a[1], d[2] - a[2] };
+  const double w[3] = { e[0] - a[0], e[1] - a[1], e[2] - a[2] };
+  return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+           u[2] * (v[0] * w[1] - v[1] * w[0])) /
+    6.0;
+}
+
+namespace
+{
+using V3 = std::array<double, 3>;
+V3 Sub(const V3& a, const V3& b)
+{
+  return { { a[0] - b[0], a[1] - b[1], a[2] - b[2] } };
+}
+V3 Cross(const V3& a, const V3& b)
+{
+  return { { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] } };
+}
+double Dot(const V3& a, const V3& b)
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+double Norm(const V3& a)
+{
+  return std::sqrt(Dot(a, a));
+}
+constexpr double Degrees = 180.0 / 3.14159265358979323846;
+} // namespace
+
+void ElementQuality(const std::vector<std::array<double, 3>>& P, const std::vector<std::int64_t>& cells, int vpc,
+  std::vector<double>& minAngle, std::vector<double>& radiusRatio, const ParallelFor& parallel)
+{
+  const std::int64_t m = static_cast<std::int64_t>(cells.size()) / vpc;
+  minAngle.assign(m, 0.0);
+  radiusRatio.assign(m, 0.0);
+  parallel(m, 4096, [&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t c = b; c < e; ++c)
+    {
+      const std::int64_t* id = cells.data() + c * vpc;
+      if (vpc == 3)
+      {
+        const V3 &a = P[id[0]], &bb = P[id[1]], &d = P[id[2]];
+        const double la = Norm(Sub(bb, d)), lb = Norm(Sub(a, d)), lc = Norm(Sub(a, bb));
+        const double area = 0.5 * Norm(Cross(Sub(bb, a), Sub(d, a)));
+        double smallest = 180.0;
+        const V3* v[3] = { &a, &bb, &d };
+        for (int k = 0; k < 3; ++k)
+        {
+          const V3 u = Sub(*v[(k + 1) % 3], *v[k]), w = Sub(*v[(k + 2) % 3], *v[k]);
+          smallest = std::min(smallest, std::atan2(Norm(Cross(u, w)), Dot(u, w)) * Degrees);
+        }
+        minAngle[c] = smallest;
+        const double s = 0.5 * (la + lb + lc);
+        const double r = area / s, R = la * lb * lc / (4.0 * area);
+        radiusRatio[c] = area > 0 ? 2.0 * r / R : 0.0;
+      }
+      else
+      {
+        const V3* v[4] = { &P[id[0]], &P[id[1]], &P[id[2]], &P[id[3]] };
+        // Face normals (any consistent sense); face f is opposite vertex f.
+        V3 n[4];
+        double faceArea = 0.0;
+        for (int f = 0; f < 4; ++f)
+        {
+          n[f] = Cross(Sub(*v[(f + 2) % 4], *v[(f + 1) % 4]), Sub(*v[(f + 3) % 4], *v[(f + 1) % 4]));
+          // Point every normal away from its opposite vertex (outward).
+          if (Dot(n[f], Sub(*v[f], *v[(f + 1) % 4])) > 0)
+          {
+            n[f] = { { -n[f][0], -n[f][1], -n[f][2] } };
+          }
+          faceArea += 0.5 * Norm(n[f]);
+        }
+        double smallest = 180.0;
+        for (int k = 0; k < 4; ++k)
+        {
+          for (int l = k + 1; l < 4; ++l)
+          {
+            // Dihedral angle at the edge shared by faces k and l: pi minus the normals' angle.
+            const double cosine = -Dot(n[k], n[l]) / (Norm(n[k]) * Norm(n[l]));
+            smallest = std::min(smallest, std::acos(std::max(-1.0, std::min(1.0, cosine))) * Degrees);
+          }
+        }
+        minAngle[c] = smallest;
+        const V3 a = Sub(*v[1], *v[0]), bb = Sub(*v[2], *v[0]), d = Sub(*v[3], *v[0]);
+        const double det = Dot(a, Cross(bb, d));
+        const double volume = std::fabs(det) / 6.0;
+        const V3 x1 = Cross(bb, d), x2 = Cross(d, a), x3 = Cross(a, bb);
+        const double la = Dot(a, a), lb = Dot(bb, bb), ld = Dot(d, d);
+        const V3 num = { { la * x1[0] + lb * x2[0] + ld * x3[0], la * x1[1] + lb * x2[1] + ld * x3[1],
+          la * x1[2] + lb * x2[2] + ld * x3[2] } };
+        const double R = Norm(num) / (2.0 * std::fabs(det));
+        const double r = 3.0 * volume / faceArea;
+        radiusRatio[c] = volume > 0 ? 3.0 * r / R : 0.0;
+      }
+    }
+  });
+}
+} // namespace featuremesh

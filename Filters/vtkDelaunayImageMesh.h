@@ -1,0 +1,67 @@
+/**
+ * @class   vtkDelaunayImageMesh
+ * @brief   Delaunay triangle / tetrahedral mesh of image nodes with exact super-pixel statistics
+ *          (FeatureMesh stage 2).
+ *
+ * Input 0 "Nodes": any vtkPointSet (e.g. Feature Nodes), its point arrays passed to the mesh
+ * points; input 1 "Image": the image whose voxels the elements summarise. 2D images give
+ * VTK_TRIANGLE cells (CGAL), 3D images VTK_TETRA cells (TetGen, or CGAL's
+ * Delaunay_triangulation_3). Missing image corners are added (NodeType 4), so the mesh tiles the
+ * image box. Every voxel centre belongs to exactly one element (see ElementRasterizer.h for the
+ * tie rule); cell arrays: PixelCount, MeanIntensity, IntensityStdDev, Interpolated (1 = element
+ * owns no centre, mean interpolated at its centroid), Quality (minimum angle / minimum dihedral
+ * angle, degrees), RadiusRatio (1 = equilateral).
+ */
+#ifndef vtkDelaunayImageMesh_h
+#define vtkDelaunayImageMesh_h
+
+#include "FeatureMeshFiltersModule.h"
+#include "vtkUnstructuredGridAlgorithm.h"
+
+class FEATUREMESHFILTERS_EXPORT vtkDelaunayImageMesh : public vtkUnstructuredGridAlgorithm
+{
+public:
+  static vtkDelaunayImageMesh* New();
+  vtkTypeMacro(vtkDelaunayImageMesh, vtkUnstructuredGridAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  enum Backends
+  {
+    TETGEN = 0,
+    CGAL = 1
+  };
+  /// 3D backend: TETGEN (default, as the thesis) or CGAL.
+  vtkSetClampMacro(Backend, int, TETGEN, CGAL);
+  vtkGetMacro(Backend, int);
+
+  /// TetGen quality refinement (3D, adds nodes with NodeType 4). Off by default.
+  vtkSetMacro(QualityRefinement, bool);
+  vtkGetMacro(QualityRefinement, bool);
+  vtkBooleanMacro(QualityRefinement, bool);
+  /// Radius-edge ratio bound (default 2) and minimum dihedral angle in degrees (default 10).
+  vtkSetMacro(RadiusEdgeRatio, double);
+  vtkGetMacro(RadiusEdgeRatio, double);
+  vtkSetMacro(MinDihedralAngle, double);
+  vtkGetMacro(MinDihedralAngle, double);
+
+  void SetImageConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(1, output); }
+
+protected:
+  vtkDelaunayImageMesh();
+  ~vtkDelaunayImageMesh() override = default;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  int Backend = TETGEN;
+  bool QualityRefinement = false;
+  double RadiusEdgeRatio = 2.0;
+  double MinDihedralAngle = 10.0;
+
+private:
+  vtkDelaunayImageMesh(const vtkDelaunayImageMesh&) = delete;
+  void operator=(const vtkDelaunayImageMesh&) = delete;
+};
+
+#endif
