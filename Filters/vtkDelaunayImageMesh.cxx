@@ -306,6 +306,21 @@ int vtkDelaunayImageMesh::RequestData(
   addField("DelaunaySeconds", delaunaySeconds);
   addField("StatisticsSeconds", statisticsSeconds);
   addField("TotalSeconds", std::chrono::duration<double>(Clock::now() - start).count());
+  // The image grid, so that later stages can rasterise onto it without the image itself.
+  auto addTuple = [&](const char* name, const double* v) {
+    vtkNew<vtkDoubleArray> a;
+    a->SetName(name);
+    a->SetNumberOfComponents(3);
+    a->InsertNextTuple(v);
+    output->GetFieldData()->AddArray(a);
+  };
+  const double dimsD[3] = { double(grid.Dims[0]), double(grid.Dims[1]), double(grid.Dims[2]) };
+  double originD[3];
+  const double zero[3] = { 0, 0, 0 };
+  IndexToWorld(image, zero, originD);
+  addTuple("ImageOrigin", originD);
+  addTuple("ImageSpacing", image->GetSpacing());
+  addTuple("ImageDimensions", dimsD);
   vtkNew<vtkStringArray> backend;
   backend->SetName("Backend");
   backend->InsertNextValue(backendName);

@@ -1,0 +1,257 @@
+// Unit tests of the VTK-free core on synthetic arrays.
+#include "BoykovJolly.h"
+#include "DelaunayMesh.h"
+#include "ElementRasterizer.h"
+#include "FeatureNodes.h"
+#include "MeshAdjacency.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+using namespace featuremesh;
+
+namespace
+{
+Grid Grid2(int nx, int ny)
+{
+  Grid g;
+  g.Dims = { { nx, ny, 1 } };
+  return g;
+}
+std::vector<float> Disk(const Grid& g, double cx, double cy, double r)
+{
+  std::vector<float> f(g.Size());
+  for (int j = 0; j < g.Dims[1]; ++j)
+    for (int i = 0; i < g.Dims[0]; ++i)
+      f[g.Index(i, j, 0)] = std::hypot(i - cx, j - cy) <= r ? 100.f : 10.f;
+  return f;
+}
+} // namespace
+
+TEST(Canny, DiskGivesRingAtRadius)
+{
+  const Grid g = Grid2(64, 64);
+  const std::vector<float> raw = Disk(g, 31.5, 31.5, 15.0);
+  std::vector<float> f(raw.size());
+  GaussianSmooth(raw.data(), f.data(), g, 0.7, SerialFor());
+  const std::vector<std::uint8_t> edges = CannyEdges(f.data(), g, 0.1, 0.6, 99.0, SerialFor());
+  int count = 0;
+  for (int j = 0; j < 64; ++j)
+    for (int i = 0; i < 64; ++i)
+      if (edges[g.Index(i, j, 0)])
+      {
+        ++count;
+        EXPECT_NEAR(std::hypot(i - 31.5, j - 31.5), 15.0, 1.0) << "edge at " << i << "," << j;
+      }
+  // A closed ring: about the circumference in pixels.
+  EXPECT_GT(count, 0.6 * 2 * M_PI * 15);
+}
+
+TEST(Canny, ConstantImageHasNoEdges)
+{
+  const Grid g = Grid2(32, 32);
+  std::vector<float> f(g.Size(), 5.f);
+  const auto edges = CannyEdges(f.data(), g, 0.1, 0.6, 99.0, SerialFor());
+  for (auto e : edges)
+    EXPECT_EQ(e, 0);
+}
+
+TEST(PCA, TightCornerIsDenseAndStraightLineSparse)
+{
+  const Grid g = Grid2(64, 64);
+  FeatureNodeParameters p;
+  std::vector<std::uint8_t> map(g.Size(), 0);
+  // A straight line; a tight hairpin corner (a 3x3 closed contour, the edge of a speck); and a
+  // right-angle L with 6-pixel arms, which the thesis's ratio classes call straight (ratio 0.26 in
+  // an 11x11 window: (var - |cov|) / (var + |cov|)).
+  for (int i = 2; i < 30; ++i)
+    map[g.Index(i, 10, 0)] = 1;
+  for (int j = 40; j <= 42; ++j)
+    for (int i = 40; i <= 42; ++i)
+      map[g.Index(i, j, 0)] = (i == 41 && j == 41) ? 0 : 1;
+  for (int t = 0; t < 6; ++t)
+  {
+    map[g.Index(10 + t, 50, 0)] = 1;
+    map[g.Index(10, 50 + t, 0)] = 1;
+  }
+  const std::vector<std::int64_t> pts = { g.Index(15, 10, 0), g.Index(40, 40, 0), g.Index(10, 50, 0) };
+  const auto radii = EdgeSampleRadii(pts, map, g, p, SerialFor());
+  EXPECT_EQ(radii[0], 5);
+  EXPECT_EQ(radii[1], 1);
+  EXPECT_EQ(radii[2], 5);
+}
+
+TEST(PCA, ThinningKeepsCornerAndSpacesLine)
+{
+  const Grid g = Grid2(64, 64);
+  std::vector<std::int64_t> pts;
+  std::vector<std::uint8_t> radii;
+  for (int i = 0; i < 30; ++i)
+  {
+    pts.push_back(g.Index(i, 10, 0));
+    radii.push_back(i == 12 ? 1 : 5);
+  }
+  const auto kept = ThinEdgePoints(pts, radii, g);
+  // The curved point goes first, and no two kept points lie within 5 of each other otherwise.
+  ASSERT_FALSE(kept.empty());
+  EXPECT_EQ(kept[0], 12);
+  EXPECT_LE(kept.size(), 30u / 5 + 2);
+  EXPECT_GE(kept.size(), 30u / 6);
+}
+
+TEST(Halftone, CountFallsAsThresholdRises)
+{
+  const Grid g = Grid2(128, 128);
+  std::vector<float> rho(g.Size());
+  for (int j = 0; j < 128; ++j)
+    for (int i = 0; i < 128; ++i)
+      rho[g.Index(i, j, 0)] = static_cast<float>(i) / 255.f;
+  size_t previous = SIZE_MAX;
+  for (double q : { 0.1, 0.2, 0.3, 0.5, 0.7, 0.9 })
+  {
+    const size_t n = Halftone(rho, g, q).size();
+    EXPECT_LT(n, previous) << "q = " << q;
+    previous = n;
+  }
+}
+
+TEST(FeatureNodes, CornersAreNodesAndOneNodePerVoxel)
+{
+  const Grid g = Grid2(50, 40);
+  const std::vector<float> f = Disk(g, 25, 20, 10);
+  FeatureNodeParameters p;
+  const auto r = ComputeFeatureNodes(f.data(), f.data(), nullptr, g, p, SerialFor(), NoProgress());
+  std::vector<int> seen(g.Size(), 0);
+  for (const auto& x : r.Positions)
+    EXPECT_EQ(seen[g.Index(x[0], x[1], x[2])]++, 0);
+  EXPECT_EQ(seen[g.Index(0, 0, 0)], 1);
+  EXPECT_EQ(seen[g.Index(49, 0, 0)], 1);
+  EXPECT_EQ(seen[g.Index(0, 39, 0)], 1);
+  EXPECT_EQ(seen[g.Index(49, 39, 0)], 1);
+  EXPECT_GT(r.Counts[NodeCanny], 0);
+}
+
+TEST(Parameters, OutOfOrderThresholdsAreRejected)
+{
+  FeatureNodeParameters p;
+  p.LowThreshold = 0.7;
+  p.HighThreshold = 0.6;
+  EXPECT_FALSE(ValidateParameters(p).empty());
+}
+
+// A random point set with the box corners: every voxel centre is owned by exactly one element,
+// in 2D and 3D, with both 3D backends.
+class Tiling : public ::testing::TestWithParam<int>
+{
+};
+TEST_P(Tiling, EveryCentreHasExactlyOneOwner)
+{
+  const int mode = GetParam(); // 0: 2D, 1: TetGen, 2: CGAL
+  Grid g;
+  g.Dims = mode == 0 ? std::array<int, 3>{ { 40, 30, 1 } } : std::array<int, 3>{ { 14, 12, 10 } };
+  std::mt19937 rng(7);
+  std::vector<std::array<double, 3>> pts;
+  std::vector<int> used(g.Size(), 0);
+  for (int c = 0; c < (mode == 0 ? 4 : 8); ++c)
+  {
+    std::array<double, 3> p = { { (c & 1) ? g.Dims[0] - 1.0 : 0, (c & 2) ? g.Dims[1] - 1.0 : 0,
+      (c & 4) ? g.Dims[2] - 1.0 : 0 } };
+    used[g.Index(int(p[0]), int(p[1]), int(p[2]))] = 1;
+    pts.push_back(p);
+  }
+  // Lattice-aligned points (many co-circular / co-spherical ties) plus random ones.
+  for (int t = 0; t < 150; ++t)
+  {
+    const int i = rng() % g.Dims[0], j = rng() % g.Dims[1], k = rng() % g.Dims[2];
+    if (!used[g.Index(i, j, k)]++)
+      pts.push_back({ { double(i), double(j), double(k) } });
+  }
+  DelaunayOptions o;
+  o.Backend = mode == 2 ? DelaunayBackend::CGAL : DelaunayBackend::TetGen;
+  const DelaunayResult mesh = mode == 0 ? Triangulate2D(pts) : Tetrahedralize(pts, o);
+  ASSERT_TRUE(mesh.Error.empty()) << mesh.Error;
+  double measure = 0.0;
+  for (size_t c = 0; c < mesh.Cells.size(); c += mesh.VerticesPerCell)
+  {
+    const double m = ElementMeasure(mesh.Points, mesh.Cells.data() + c, mesh.VerticesPerCell);
+    EXPECT_GT(m, 0.0);
+    measure += m;
+  }
+  const double box = (g.Dims[0] - 1.0) * (g.Dims[1] - 1.0) * (mode == 0 ? 1.0 : g.Dims[2] - 1.0);
+  EXPECT_NEAR(measure, box, 1e-9 * box);
+  ElementRasterizer raster(mesh.Points, mesh.Cells, mesh.VerticesPerCell, g);
+  std::vector<int> owners(g.Size(), 0);
+  for (std::int64_t e = 0; e < raster.NumberOfElements(); ++e)
+    raster.ForEachVoxel(e, [&](std::int64_t v) { owners[v]++; });
+  for (std::int64_t v = 0; v < g.Size(); ++v)
+    ASSERT_EQ(owners[v], 1) << "voxel " << v;
+  // Hull faces cover the box surface: their measure sums to its area/perimeter.
+  const MeshAdjacency adj = BuildAdjacency(mesh.Points, mesh.Cells, mesh.VerticesPerCell);
+  EXPECT_EQ(2 * adj.A.size() + adj.HullElement.size(), mesh.Cells.size());
+}
+INSTANTIATE_TEST_SUITE_P(Delaunay, Tiling, ::testing::Values(0, 1, 2));
+
+TEST(Delaunay, DegenerateInputIsAnError)
+{
+  std::vector<std::array<double, 3>> line = { { { 0, 0, 0 } }, { { 1, 1, 0 } }, { { 2, 2, 0 } } };
+  EXPECT_FALSE(Triangulate2D(line).Error.empty());
+  std::vector<std::array<double, 3>> plane = { { { 0, 0, 0 } }, { { 1, 0, 0 } }, { { 0, 1, 0 } }, { { 1, 1, 0 } },
+    { { 2, 3, 0 } } };
+  EXPECT_FALSE(Tetrahedralize(plane, DelaunayOptions()).Error.empty());
+  DelaunayOptions cgal;
+  cgal.Backend = DelaunayBackend::CGAL;
+  EXPECT_FALSE(Tetrahedralize(plane, cgal).Error.empty());
+  EXPECT_EQ(CountDuplicates({ { { 0, 0, 0 } }, { { 1, 0, 0 } }, { { 0, 0, 0 } } }), 1);
+}
+
+TEST(Statistics, MeanAndCountAreExact)
+{
+  Grid g;
+  g.Dims = { { 5, 4, 1 } };
+  std::vector<std::array<double, 3>> pts = { { { 0, 0, 0 } }, { { 4, 0, 0 } }, { { 4, 3, 0 } }, { { 0, 3, 0 } } };
+  const DelaunayResult mesh = Triangulate2D(pts);
+  ASSERT_TRUE(mesh.Error.empty());
+  std::vector<double> values(g.Size());
+  for (std::int64_t v = 0; v < g.Size(); ++v)
+    values[v] = static_cast<double>(v);
+  ElementRasterizer raster(mesh.Points, mesh.Cells, 3, g);
+  const auto s = ComputeElementStatistics(raster, mesh.Points, mesh.Cells, 3, values.data(), g, SerialFor());
+  std::int64_t total = 0;
+  double sum = 0.0;
+  for (size_t e = 0; e < s.PixelCount.size(); ++e)
+  {
+    total += s.PixelCount[e];
+    sum += s.Mean[e] * s.PixelCount[e];
+  }
+  EXPECT_EQ(total, 20);
+  EXPECT_NEAR(sum, 190.0, 1e-9);
+}
+
+TEST(BoykovJolly, SeparatesTwoPlateausAndHonoursSeeds)
+{
+  // A chain of 20 nodes: values 0 then 10, a seed at each end.
+  CutProblem pr;
+  for (int i = 0; i < 20; ++i)
+  {
+    pr.Value.push_back(i < 8 ? 10.0 : 0.0);
+    pr.Size.push_back(1.0);
+    pr.Hard.push_back(i == 0 ? 1 : (i == 19 ? 2 : 0));
+    if (i > 0)
+    {
+      pr.A.push_back(i - 1);
+      pr.B.push_back(i);
+      pr.Contact.push_back(1.0);
+    }
+  }
+  pr.ObjectSamples = { 10.0, 10.0, 9.5 };
+  pr.BackgroundSamples = { 0.0, 0.5, 0.0 };
+  const CutResult r = BoykovJollyCut(pr, BoykovJollyParameters());
+  ASSERT_TRUE(r.Error.empty());
+  for (int i = 0; i < 20; ++i)
+    EXPECT_EQ(r.Label[i], i < 8 ? 1 : 0) << i;
+  BoykovJollyParameters bad;
+  bad.Lambda = -1;
+  EXPECT_FALSE(ValidateParameters(bad).empty());
+}

@@ -1,0 +1,198 @@
+// Rendering regression tests: each scene runs the filters on bundled data and compares the
+// picture with a committed baseline (vtkRegressionTestImage, -V baseline -T temporary dir).
+#include "vtkDelaunayImageMesh.h"
+#include "vtkFeatureNodes.h"
+#include "vtkSuperVoxelCut.h"
+
+#include "vtkActor.h"
+#include "vtkCamera.h"
+#include "vtkCellArray.h"
+#include "vtkDataSetMapper.h"
+#include "vtkImageActor.h"
+#include "vtkImageData.h"
+#include "vtkImageMapper3D.h"
+#include "vtkImageProperty.h"
+#include "vtkMetaImageReader.h"
+#include "vtkNew.h"
+#include "vtkPlane.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkPolyDataMapper.h"
+#include "vtkProperty.h"
+#include "vtkRegressionTestImage.h"
+#include "vtkRenderWindow.h"
+#include "vtkRenderer.h"
+#include "vtkTableBasedClipDataSet.h"
+#include "vtkUnstructuredGrid.h"
+
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+
+namespace
+{
+vtkSmartPointer<vtkPolyData> ReadSeeds(const std::string& file)
+{
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> pts;
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line); // header x,y,z
+  while (std::getline(in, line))
+  {
+    std::stringstream ss(line);
+    double x[3];
+    char comma;
+    if (ss >> x[0] >> comma >> x[1] >> comma >> x[2])
+    {
+      pts->InsertNextPoint(x);
+    }
+  }
+  pd->SetPoints(pts);
+  return pd;
+}
+
+void AddImage(vtkRenderer* ren, vtkImageData* image, double window, double level)
+{
+  vtkNew<vtkImageActor> actor;
+  actor->GetMapper()->SetInputData(image);
+  actor->GetProperty()->SetColorWindow(window);
+  actor->GetProperty()->SetColorLevel(level);
+  actor->SetPosition(0, 0, -0.5);
+  ren->AddViewProp(actor);
+}
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  if (argc < 3)
+  {
+    std::cerr << "usage: " << argv[0] << " Scene DataDir -V baseline.png -T tmpdir\n";
+    return 1;
+  }
+  const std::string scene = argv[1], data = argv[2];
+  const bool liver = scene.rfind("Liver", 0) == 0;
+  const std::string caseDir = data + (liver ? "/liver-ct-totalseg/" : "/nuclei-dsb2018/");
+
+  vtkNew<vtkMetaImageReader> reader;
+  reader->SetFileName((caseDir + "image.mha").c_str());
+  reader->Update();
+  vtkImageData* image = reader->GetOutput();
+
+  vtkNew<vtkFeatureNodes> nodes;
+  nodes->SetInputConnection(reader->GetOutputPort());
+  vtkNew<vtkDelaunayImageMesh> mesh;
+  mesh->SetInputConnection(0, nodes->GetOutputPort(0));
+  mesh->SetInputConnection(1, reader->GetOutputPort());
+  vtkNew<vtkSuperVoxelCut> cut;
+  cut->SetInputConnection(0, mesh->GetOutputPort());
+  cut->SetInputData(1, ReadSeeds(caseDir + "seeds_object.csv"));
+  cut->SetInputData(2, ReadSeeds(caseDir + "seeds_background.csv"));
+  cut->SetInputConnection(3, reader->GetOutputPort());
+
+  vtkNew<vtkRenderer> ren;
+  ren->SetBackground(0.1, 0.1, 0.15);
+  vtkNew<vtkRenderWindow> win;
+  win->SetSize(400, 400);
+  win->AddRenderer(ren);
+  win->SetMultiSamples(0);
+
+  if (scene == "NucleiNodes")
+  {
+    nodes->Update();
+    AddImage(ren, image, 120, 60);
+    vtkNew<vtkPolyDataMapper> mapper;
+    mapper->SetInputConnection(nodes->GetOutputPort(0));
+    mapper->SetScalarRange(0, 3);
+    mapper->SetColorModeToMapScalars();
+    vtkNew<vtkActor> actor;
+    actor->SetMapper(mapper);
+    actor->GetProperty()->SetPointSize(3);
+    actor->SetPosition(0, 0, 1);
+    ren->AddActor(actor);
+  }
+  else if (scene == "NucleiMesh")
+  {
+    vtkNew<vtkDataSetMapper> mapper;
+    mapper->SetInputConnection(mesh->GetOutputPort());
+    mapper->SetScalarModeToUseCellFieldData();
+    mapper->SelectColorArray("MeanIntensity");
+    mapper->SetScalarRange(0, 120);
+    vtkNew<vtkActor> actor;
+    actor->SetMapper(mapper);
+    actor->GetProperty()->EdgeVisibilityOn();
+    actor->GetProperty()->SetEdgeColor(0.2, 0.2, 0.2);
+    ren->AddActor(actor);
+  }
+  else if (scene == "NucleiSegmentation")
+  {
+    AddImage(ren, image, 120, 60);
+    vtkNew<vtkPolyDataMapper> mapper;
+    mapper->SetInputConnection(cut->GetOutputPort(1));
+    mapper->ScalarVisibilityOff();
+    vtkNew<vtkActor> actor;
+    actor->SetMapper(mapper);
+    actor->GetProperty()->SetColor(1, 0.2, 0.2);
+    actor->GetProperty()->SetLineWidth(2);
+    actor->SetPosition(0, 0, 1);
+    ren->AddActor(actor);
+  }
+  else if (scene == "LiverMesh")
+  {
+    vtkNew<vtkPlane> plane;
+    plane->SetOrigin(180, 150, 45);
+    plane->SetNormal(0, 0, 1);
+    vtkNew<vtkTableBasedClipDataSet> clip;
+    clip->SetInputConnection(mesh->GetOutputPort());
+    clip->SetClipFunction(plane);
+    clip->InsideOutOn();
+    vtkNew<vtkDataSetMapper> mapper;
+    mapper->SetInputConnection(clip->GetOutputPort());
+    mapper->SetScalarModeToUseCellFieldData();
+    mapper->SelectColorArray("MeanIntensity");
+    mapper->SetScalarRange(-150, 250);
+    vtkNew<vtkActor> actor;
+    actor->SetMapper(mapper);
+    actor->GetProperty()->EdgeVisibilityOn();
+    actor->GetProperty()->SetEdgeColor(0.1, 0.1, 0.1);
+    ren->AddActor(actor);
+    ren->GetActiveCamera()->Elevation(-50);
+  }
+  else if (scene == "LiverSurface")
+  {
+    vtkNew<vtkPolyDataMapper> mapper;
+    mapper->SetInputConnection(cut->GetOutputPort(1));
+    mapper->ScalarVisibilityOff();
+    vtkNew<vtkActor> actor;
+    actor->SetMapper(mapper);
+    actor->GetProperty()->SetColor(0.8, 0.45, 0.35);
+    ren->AddActor(actor);
+    ren->GetActiveCamera()->Elevation(-60);
+    ren->GetActiveCamera()->Azimuth(20);
+  }
+  else
+  {
+    std::cerr << "unknown scene " << scene << "\n";
+    return 1;
+  }
+  ren->ResetCamera();
+  if (scene.rfind("Nuclei", 0) == 0)
+  {
+    ren->GetActiveCamera()->Zoom(1.4);
+  }
+  win->Render();
+  // A missing baseline is a failure, not a silent pass.
+  for (int a = 1; a + 1 < argc; ++a)
+  {
+    if (std::string(argv[a]) == "-V" && !std::ifstream(argv[a + 1]).good() && !std::getenv("FEATUREMESH_MAKE_BASELINES"))
+    {
+      std::cerr << "baseline " << argv[a + 1] << " is missing (set FEATUREMESH_MAKE_BASELINES=1 to write it)\n";
+      return 1;
+    }
+  }
+  const int result = vtkRegressionTestImage(win);
+  return result == vtkRegressionTester::FAILED ? 1 : 0;
+}
