@@ -79,8 +79,12 @@ int vtkDelaunayImageMesh::RequestData(
     return 0;
   }
   std::vector<double> values;
-  vtkDataArray* array =
-    ChosenArray(image, this->GetInputArrayInformation(0), error);
+  std::string warning;
+  vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
+  if (!warning.empty())
+  {
+    vtkWarningMacro("Delaunay Image Mesh: " << warning);
+  }
   if (!array || !ToDouble(array, values, error))
   {
     vtkErrorMacro("Delaunay Image Mesh: " << error);
@@ -126,6 +130,13 @@ int vtkDelaunayImageMesh::RequestData(
   {
     vtkErrorMacro("Delaunay Image Mesh: " << duplicates
                                           << " nodes duplicate other nodes; remove them (e.g. with Clean) first.");
+    return 0;
+  }
+  if (!SpansDimension(index, is2D ? 2 : 3))
+  {
+    vtkErrorMacro("Delaunay Image Mesh: the nodes are " << (is2D ? "collinear" : "coplanar (or collinear)")
+                                                        << "; a mesh needs nodes spanning the image's "
+                                                        << (is2D ? "area." : "volume."));
     return 0;
   }
   // The mesh must tile the box: add the image corners that are not nodes yet.

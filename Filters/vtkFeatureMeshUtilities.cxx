@@ -149,17 +149,27 @@ bool ToDouble(vtkDataArray* array, std::vector<double>& values, std::string& err
   return ToValues(array, values, error);
 }
 
-vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::string& error)
+vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::string& error, std::string& warning)
 {
   const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME()) ? arrayInfo->Get(vtkDataObject::FIELD_NAME()) : nullptr;
   vtkDataArray* array = nullptr;
   if (name && *name)
   {
     array = image->GetPointData()->GetArray(name);
+    if (array)
+    {
+      return array;
+    }
+    // pvpython can carry a name over from a previously active source: fall back to the image's
+    // active scalars, and say so.
+    array = image->GetPointData()->GetScalars();
     if (!array)
     {
       error = std::string("the image has no point array named '") + name + "'.";
+      return nullptr;
     }
+    warning = std::string("the image has no point array named '") + name + "'; using its active scalars '" +
+      (array->GetName() ? array->GetName() : "") + "'.";
     return array;
   }
   array = image->GetPointData()->GetScalars();

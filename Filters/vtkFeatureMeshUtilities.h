@@ -43,8 +43,9 @@ bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error
 
 // The image point array named by SetInputArrayToProcess (looked up on `image`, whatever port the
 // selection names), or the active point scalars when no name was given (ParaView sends an empty
-// name when the input had not run yet). Null with an error sentence when a named array is missing.
-vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::string& error);
+// name when the input had not run yet). A missing named array falls back to the active scalars with
+// a warning sentence; null with an error sentence when there are none.
+vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::string& error, std::string& warning);
 
 // Index-space coordinates (relative to the extent's start) of a world point.
 void WorldToIndex(vtkImageData* image, const double world[3], double index[3]);

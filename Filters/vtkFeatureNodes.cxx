@@ -119,8 +119,12 @@ int vtkFeatureNodes::RequestData(
   }
 
   std::vector<float> values;
-  vtkDataArray* array =
-    ChosenArray(input, this->GetInputArrayInformation(0), error);
+  std::string warning;
+  vtkDataArray* array = ChosenArray(input, this->GetInputArrayInformation(0), error, warning);
+  if (!warning.empty())
+  {
+    vtkWarningMacro("Feature Nodes: " << warning);
+  }
   if (!array || !ToFloat(array, values, error))
   {
     vtkErrorMacro("Feature Nodes: " << error);

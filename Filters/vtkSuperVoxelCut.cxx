@@ -264,7 +264,12 @@ int vtkSuperVoxelCut::RequestData(
   if (image)
   {
     std::vector<double> values;
-    vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error);
+    std::string warning;
+    vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
+    if (!warning.empty())
+    {
+      vtkWarningMacro("Super-Voxel Cut: " << warning);
+    }
     if (!array || !ToDouble(array, values, error))
     {
       vtkErrorMacro("Super-Voxel Cut: " << error);

@@ -86,7 +86,12 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     return 0;
   }
   CutProblem pr;
-  vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error);
+  std::string warning;
+  vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
+  if (!warning.empty())
+  {
+    vtkWarningMacro("Voxel Cut: " << warning);
+  }
   if (!array || !ToDouble(array, pr.Value, error))
   {
     vtkErrorMacro("Voxel Cut: " << error);

@@ -130,6 +130,50 @@ DelaunayResult TetrahedralizeTetGen(const std::vector<std::array<double, 3>>& po
 }
 } // namespace
 
+bool SpansDimension(const std::vector<std::array<double, 3>>& points, int dimension)
+{
+  if (points.size() < static_cast<size_t>(dimension + 1))
+  {
+    return false;
+  }
+  // A first distinct point, a first point off their line, then (3D) a first point off their plane.
+  const auto& a = points[0];
+  size_t bi = 0, ci = 0;
+  for (size_t i = 1; i < points.size() && !bi; ++i)
+  {
+    if (points[i][0] != a[0] || points[i][1] != a[1] || (dimension == 3 && points[i][2] != a[2]))
+    {
+      bi = i;
+    }
+  }
+  for (size_t i = bi + 1; bi && i < points.size() && !ci; ++i)
+  {
+    const bool offLine = dimension == 2
+      ? CGAL::orientation(K::Point_2(a[0], a[1]), K::Point_2(points[bi][0], points[bi][1]),
+          K::Point_2(points[i][0], points[i][1])) != CGAL::COLLINEAR
+      : !CGAL::collinear(K::Point_3(a[0], a[1], a[2]), K::Point_3(points[bi][0], points[bi][1], points[bi][2]),
+          K::Point_3(points[i][0], points[i][1], points[i][2]));
+    if (offLine)
+    {
+      ci = i;
+    }
+  }
+  if (!ci || dimension == 2)
+  {
+    return ci != 0;
+  }
+  for (size_t i = ci + 1; i < points.size(); ++i)
+  {
+    if (CGAL::orientation(K::Point_3(a[0], a[1], a[2]), K::Point_3(points[bi][0], points[bi][1], points[bi][2]),
+          K::Point_3(points[ci][0], points[ci][1], points[ci][2]),
+          K::Point_3(points[i][0], points[i][1], points[i][2])) != CGAL::COPLANAR)
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
 std::int64_t CountDuplicates(const std::vector<std::array<double, 3>>& points)
 {
   std::vector<std::array<double, 3>> sorted(points);
@@ -183,37 +227,9 @@ DelaunayResult Tetrahedralize(const std::vector<std::array<double, 3>>& points, 
 {
   try
   {
-    // Coplanarity is checked first with CGAL's exact predicates: TetGen on such input is not
+    // Coplanarity is checked first with exact predicates: TetGen on such input is not
     // guaranteed to fail cleanly.
-    bool spansVolume = false;
-    if (points.size() >= 4)
-    {
-      // First non-coplanar quadruple, found in one pass after fixing a non-collinear triple.
-      const auto& a = points[0];
-      size_t bi = 0, ci = 0;
-      for (size_t i = 1; i < points.size() && !bi; ++i)
-      {
-        if (points[i] != a)
-        {
-          bi = i;
-        }
-      }
-      for (size_t i = bi + 1; bi && i < points.size() && !ci; ++i)
-      {
-        if (!CGAL::collinear(K::Point_3(a[0], a[1], a[2]), K::Point_3(points[bi][0], points[bi][1], points[bi][2]),
-              K::Point_3(points[i][0], points[i][1], points[i][2])))
-        {
-          ci = i;
-        }
-      }
-      for (size_t i = ci + 1; ci && i < points.size() && !spansVolume; ++i)
-      {
-        spansVolume = CGAL::orientation(K::Point_3(a[0], a[1], a[2]),
-                        K::Point_3(points[bi][0], points[bi][1], points[bi][2]),
-                        K::Point_3(points[ci][0], points[ci][1], points[ci][2]),
-                        K::Point_3(points[i][0], points[i][1], points[i][2])) != CGAL::COPLANAR;
-      }
-    }
+    const bool spansVolume = SpansDimension(points, 3);
     if (!spansVolume)
     {
       DelaunayResult r;

@@ -39,6 +39,9 @@ struct DelaunayResult
 DelaunayResult Triangulate2D(const std::vector<std::array<double, 3>>& points);
 DelaunayResult Tetrahedralize(const std::vector<std::array<double, 3>>& points, const DelaunayOptions& options);
 
+// True when the points span an area (dimension 2, xy) or a volume (dimension 3); exact predicates.
+bool SpansDimension(const std::vector<std::array<double, 3>>& points, int dimension);
+
 // Number of points that repeat an earlier point exactly.
 std::int64_t CountDuplicates(const std::vector<std::array<double, 3>>& points);
 } // namespace featuremesh

@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# The main job: set up, then segment the bundled 2D and 3D cases into out/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+for c in nuclei-dsb2018 liver-ct-totalseg; do
+  xvfb-run -a pvpython scripts/featuremesh_segment.py "Data/$c/image.mha" \
+    --object-seeds "Data/$c/seeds_object.csv" --background-seeds "Data/$c/seeds_background.csv" \
+    --truth "Data/$c/truth.mha" --out out
+done
