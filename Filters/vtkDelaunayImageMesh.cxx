@@ -302,21 +302,15 @@ int vtkDelaunayImageMesh::RequestData(
   output->GetCellData()->SetActiveScalars("MeanIntensity");
 
   // Field data: a summary a user (or a report) can read without recomputing.
-  auto addField = [&](const char* name, double value) {
-    vtkNew<vtkDoubleArray> a;
-    a->SetName(name);
-    a->InsertNextValue(value);
-    output->GetFieldData()->AddArray(a);
-  };
-  addField("NumberOfNodes", static_cast<double>(nPts));
-  addField("NumberOfElements", static_cast<double>(nCells));
-  addField("AddedNodes", static_cast<double>(nPts - nIn));
+  AddFieldValue(output, "NumberOfNodes", static_cast<double>(nPts));
+  AddFieldValue(output, "NumberOfElements", static_cast<double>(nCells));
+  AddFieldValue(output, "AddedNodes", static_cast<double>(nPts - nIn));
   const auto mm = std::minmax_element(quality.begin(), quality.end());
-  addField(is2D ? "MinAngle" : "MinDihedralAngle", nCells ? *mm.first : 0.0);
-  addField(is2D ? "MaxAngleOfMinAngles" : "MaxOfMinDihedralAngles", nCells ? *mm.second : 0.0);
-  addField("DelaunaySeconds", delaunaySeconds);
-  addField("StatisticsSeconds", statisticsSeconds);
-  addField("TotalSeconds", std::chrono::duration<double>(Clock::now() - start).count());
+  AddFieldValue(output, is2D ? "MinAngle" : "MinDihedralAngle", nCells ? *mm.first : 0.0);
+  AddFieldValue(output, is2D ? "MaxAngleOfMinAngles" : "MaxOfMinDihedralAngles", nCells ? *mm.second : 0.0);
+  AddFieldValue(output, "DelaunaySeconds", delaunaySeconds);
+  AddFieldValue(output, "StatisticsSeconds", statisticsSeconds);
+  AddFieldValue(output, "TotalSeconds", std::chrono::duration<double>(Clock::now() - start).count());
   // The image grid, so that later stages can rasterise onto it without the image itself.
   auto addTuple = [&](const char* name, const double* v) {
     vtkNew<vtkDoubleArray> a;

@@ -2,6 +2,9 @@
 
 #include "vtkAlgorithm.h"
 #include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
+#include "vtkNew.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -178,6 +181,14 @@ vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::s
     error = "the image has no point scalars to process; choose a point data array.";
   }
   return array;
+}
+
+void AddFieldValue(vtkDataObject* object, const char* name, double value)
+{
+  vtkNew<vtkDoubleArray> a;
+  a->SetName(name);
+  a->InsertNextValue(value);
+  object->GetFieldData()->AddArray(a);
 }
 
 void WorldToIndex(vtkImageData* image, const double world[3], double index[3])

@@ -10,6 +10,7 @@
 #include <vector>
 
 class vtkAlgorithm;
+class vtkDataObject;
 class vtkDataArray;
 class vtkImageData;
 class vtkInformation;
@@ -46,6 +47,9 @@ bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error
 // name when the input had not run yet). A missing named array falls back to the active scalars with
 // a warning sentence; null with an error sentence when there are none.
 vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::string& error, std::string& warning);
+
+// Adds a one-value double array `name` to the object's field data (summaries, timings).
+void AddFieldValue(vtkDataObject* object, const char* name, double value);
 
 // Index-space coordinates (relative to the extent's start) of a world point.
 void WorldToIndex(vtkImageData* image, const double world[3], double index[3]);

@@ -383,23 +383,17 @@ int vtkSuperVoxelCut::RequestData(
   });
   labelImage->GetPointData()->SetScalars(voxels);
 
-  auto addField = [&](vtkDataObject* d, const char* name, double value) {
-    vtkNew<vtkDoubleArray> a;
-    a->SetName(name);
-    a->InsertNextValue(value);
-    d->GetFieldData()->AddArray(a);
-  };
   std::int64_t objectElements = std::count(cut.Label.begin(), cut.Label.end(), 1);
   for (vtkDataObject* d : { static_cast<vtkDataObject*>(output), static_cast<vtkDataObject*>(labelImage) })
   {
-    addField(d, "Sigma", cut.Sigma);
-    addField(d, "Bins", cut.Bins);
-    addField(d, "Flow", cut.Flow);
-    addField(d, "ObjectElements", static_cast<double>(objectElements));
-    addField(d, "SetupSeconds", setupSeconds);
-    addField(d, "GraphSeconds", cut.GraphSeconds);
-    addField(d, "FlowSeconds", cut.FlowSeconds);
-    addField(d, "CutTotalSeconds", std::chrono::duration<double>(Clock::now() - start).count());
+    AddFieldValue(d, "Sigma", cut.Sigma);
+    AddFieldValue(d, "Bins", cut.Bins);
+    AddFieldValue(d, "Flow", cut.Flow);
+    AddFieldValue(d, "ObjectElements", static_cast<double>(objectElements));
+    AddFieldValue(d, "SetupSeconds", setupSeconds);
+    AddFieldValue(d, "GraphSeconds", cut.GraphSeconds);
+    AddFieldValue(d, "FlowSeconds", cut.FlowSeconds);
+    AddFieldValue(d, "CutTotalSeconds", std::chrono::duration<double>(Clock::now() - start).count());
   }
   this->UpdateProgress(1.0);
   return 1;

@@ -180,18 +180,12 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
   labels->SetNumberOfTuples(n);
   std::copy(cut.Label.begin(), cut.Label.end(), labels->GetPointer(0));
   output->GetPointData()->SetScalars(labels);
-  auto addField = [&](const char* name, double value) {
-    vtkNew<vtkDoubleArray> a;
-    a->SetName(name);
-    a->InsertNextValue(value);
-    output->GetFieldData()->AddArray(a);
-  };
-  addField("Sigma", cut.Sigma);
-  addField("Bins", cut.Bins);
-  addField("Flow", cut.Flow);
-  addField("GraphSeconds", cut.GraphSeconds);
-  addField("FlowSeconds", cut.FlowSeconds);
-  addField("TotalSeconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  AddFieldValue(output, "Sigma", cut.Sigma);
+  AddFieldValue(output, "Bins", cut.Bins);
+  AddFieldValue(output, "Flow", cut.Flow);
+  AddFieldValue(output, "GraphSeconds", cut.GraphSeconds);
+  AddFieldValue(output, "FlowSeconds", cut.FlowSeconds);
+  AddFieldValue(output, "TotalSeconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   this->UpdateProgress(1.0);
   return 1;
 }
