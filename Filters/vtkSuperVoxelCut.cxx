@@ -261,9 +261,9 @@ int vtkSuperVoxelCut::RequestData(
   }
   // Seed histograms: the voxels of the seed elements when the image is there, else their means
   // weighted by their voxel counts.
+  std::vector<double> values;
   if (image)
   {
-    std::vector<double> values;
     std::string warning;
     vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
     if (!warning.empty())
@@ -296,6 +296,12 @@ int vtkSuperVoxelCut::RequestData(
         w.push_back(std::max(1.0, pr.Size[c]));
       }
     }
+  }
+  if (image && this->VoxelRegionTerm)
+  {
+    pr.PixelValue = values.data();
+    pr.PixelOwner = owner.data();
+    pr.PixelTotal = geo.G.Size();
   }
   const double setupSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
   this->UpdateProgress(0.4);
@@ -405,5 +411,6 @@ void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Bins: " << this->Bins << "\n"
      << indent << "Sigma: " << this->Sigma << "\n"
      << indent << "Lambda: " << this->Lambda << "\n"
-     << indent << "ScaleByContact: " << this->ScaleByContact << "\n";
+     << indent << "ScaleByContact: " << this->ScaleByContact << "\n"
+     << indent << "VoxelRegionTerm: " << this->VoxelRegionTerm << "\n";
 }

@@ -39,6 +39,11 @@ public:
   vtkSetMacro(ScaleByContact, bool);
   vtkGetMacro(ScaleByContact, bool);
   vtkBooleanMacro(ScaleByContact, bool);
+  /// With the Image connected: an element's region cost is the sum of its voxels' costs (default on)
+  /// rather than its voxel count times the cost of its mean.
+  vtkSetMacro(VoxelRegionTerm, bool);
+  vtkGetMacro(VoxelRegionTerm, bool);
+  vtkBooleanMacro(VoxelRegionTerm, bool);
 
 protected:
   vtkSuperVoxelCut();
@@ -53,6 +58,7 @@ protected:
   double Sigma = 0.0;
   double Lambda = 1.0;
   bool ScaleByContact = true;
+  bool VoxelRegionTerm = true;
 
 private:
   vtkSuperVoxelCut(const vtkSuperVoxelCut&) = delete;

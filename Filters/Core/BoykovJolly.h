@@ -34,6 +34,13 @@ struct CutProblem
   std::vector<double> Contact; // per edge, in voxel faces
   std::vector<std::uint8_t> Hard; // 0 free, 1 object seed, 2 background seed
   std::vector<double> ObjectSamples, ObjectWeights, BackgroundSamples, BackgroundWeights;
+  // Optional exact region term for super-voxels (not owned; both set or both null): node p's region
+  // cost becomes the sum over its voxels v (PixelOwner[v] == p, -1 = none) of -ln Pr(PixelValue[v] | L)
+  // instead of Size_p * -ln Pr(Value_p | L). A mixed element then costs what its voxels would cost
+  // in the voxel cut, rather than what its mean would.
+  const double* PixelValue = nullptr;
+  const std::int64_t* PixelOwner = nullptr;
+  std::int64_t PixelTotal = 0;
 };
 
 struct CutResult

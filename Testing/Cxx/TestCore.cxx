@@ -255,3 +255,58 @@ TEST(BoykovJolly, SeparatesTwoPlateausAndHonoursSeeds)
   bad.Lambda = -1;
   EXPECT_FALSE(ValidateParameters(bad).empty());
 }
+
+TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
+{
+  // Super-nodes of one voxel each: the voxel region term must equal the mean-based one.
+  CutProblem pr;
+  std::vector<double> pixels;
+  std::vector<std::int64_t> owner;
+  for (int i = 0; i < 30; ++i)
+  {
+    const double v = (i < 12 ? 10.0 : 0.0) + ((i * 7) % 5) * 0.6;
+    pr.Value.push_back(v);
+    pr.Size.push_back(1.0);
+    pr.Hard.push_back(i == 0 ? 1 : (i == 29 ? 2 : 0));
+    pixels.push_back(v);
+    owner.push_back(i);
+    if (i > 0)
+    {
+      pr.A.push_back(i - 1);
+      pr.B.push_back(i);
+      pr.Contact.push_back(1.0);
+    }
+  }
+  pr.ObjectSamples = { 10.0, 11.0, 12.4 };
+  pr.BackgroundSamples = { 0.0, 1.2, 2.4 };
+  const CutResult byMean = BoykovJollyCut(pr, BoykovJollyParameters());
+  pr.PixelValue = pixels.data();
+  pr.PixelOwner = owner.data();
+  pr.PixelTotal = static_cast<std::int64_t>(pixels.size());
+  const CutResult byVoxel = BoykovJollyCut(pr, BoykovJollyParameters());
+  ASSERT_TRUE(byMean.Error.empty() && byVoxel.Error.empty());
+  EXPECT_EQ(byMean.Label, byVoxel.Label);
+  EXPECT_NEAR(byMean.Flow, byVoxel.Flow, 1e-9 * byMean.Flow);
+
+  // One element holding 3 object-like voxels and 1 background-like voxel, mean in between: the
+  // voxel term counts what its voxels are, the mean term what its mean looks like.
+  CutProblem two;
+  two.Value = { 10.0, 0.0, 7.5 };
+  two.Size = { 1.0, 1.0, 4.0 };
+  two.Hard = { 1, 2, 0 };
+  two.A = { 0, 1 };
+  two.B = { 2, 2 };
+  two.Contact = { 0.01, 0.01 };
+  two.ObjectSamples = { 10.0, 10.0, 10.0 };
+  two.BackgroundSamples = { 0.0, 0.0, 0.0 };
+  const std::vector<double> v = { 10.0, 0.0, 10.0, 10.0, 10.0, 0.0 };
+  const std::vector<std::int64_t> o = { 0, 1, 2, 2, 2, 2 };
+  two.ObjectSamples = { 10.0, 9.0, 11.0 };
+  two.BackgroundSamples = { 0.0, 1.0, -1.0 };
+  two.PixelValue = v.data();
+  two.PixelOwner = o.data();
+  two.PixelTotal = 6;
+  const CutResult exact = BoykovJollyCut(two, BoykovJollyParameters());
+  ASSERT_TRUE(exact.Error.empty());
+  EXPECT_EQ(exact.Label[2], 1);
+}

@@ -9,8 +9,8 @@ from vtkmodules.vtkFiltersCore import vtkFeatureEdges
 import fmtest as ft
 
 # Floors: measured values at the defaults (lambda 1) minus 0.02. Measured: nuclei super-voxel
-# 0.835, voxel 0.867; liver super-voxel 0.589, voxel 0.586.
-FLOORS = {"nuclei-dsb2018": (0.815, 0.847), "liver-ct-totalseg": (0.569, 0.566)}
+# 0.838, voxel 0.867; liver super-voxel 0.669, voxel 0.586.
+FLOORS = {"nuclei-dsb2018": (0.818, 0.847), "liver-ct-totalseg": (0.649, 0.566)}
 
 
 def run(case):
@@ -40,8 +40,7 @@ for case, (svc_floor, voxel_floor) in FLOORS.items():
     ds, dv = ft.dice(L, T), ft.dice(V, T)
     ft.check(ds >= svc_floor, "%s: super-voxel cut Dice %.3f (>= %.3f)" % (case, ds, svc_floor))
     ft.check(dv >= voxel_floor, "%s: voxel cut Dice %.3f (>= %.3f)" % (case, dv, voxel_floor))
-    # The issue asks for >= voxel - 0.03; nuclei misses it by 0.002 at the defaults (see the closing note).
-    ft.check(ds >= dv - 0.04, "%s: super-voxel Dice %.3f within 0.04 of the voxel cut's %.3f" % (case, ds, dv))
+    ft.check(ds >= dv - 0.03, "%s: super-voxel Dice %.3f not below the voxel cut's %.3f - 0.03" % (case, ds, dv))
     # Seeded elements carry their seed's label: find each seed's element through the label image.
     im = ft.fetch(image)
     dims, sp = np.array(im.GetDimensions()), np.array(im.GetSpacing())
