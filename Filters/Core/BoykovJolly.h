@@ -5,8 +5,11 @@
 //   E(L) = lambda * sum_p size_p * -ln Pr(I_p | L_p) + sum_pq contact_pq * exp(-(I_p - I_q)^2 / 2 sigma^2) [L_p != L_q]
 //
 // Pr(I | object/background) is a kernel density estimate of the seed samples on a histogram over a
-// robust intensity range (0.5 to 99.5 percentiles of the node intensities), mixed with 1 % of a
-// uniform density so that no intensity is impossible.
+// robust intensity range (0.5 to 99.5 percentiles of the node intensities, or of the voxel values
+// with the voxel region term), mixed with 1 % of a uniform density so that no intensity is impossible.
+// With the voxel region term (PixelValue/PixelOwner set) a super-voxel's region cost is the sum of
+// its voxels' costs, so for region terms the super-voxel cut is the voxel cut restricted to labellings
+// that are constant on elements.
 #pragma once
 
 #include <cstdint>

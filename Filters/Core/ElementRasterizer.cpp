@@ -18,39 +18,6 @@ ElementRasterizer::ElementRasterizer(const std::vector<std::array<double, 3>>& i
   }
 }
 
-bool ElementRasterizer::Owns(const double* plane, int faces, double x, double y, double z) const
-{
-  for (int f = 0; f < faces; ++f)
-  {
-    const double* n = plane + 4 * f;
-    const double lambda = n[0] * x + n[1] * y + n[2] * z + n[3];
-    if (lambda > 0)
-    {
-      continue;
-    }
-    if (lambda < 0)
-    {
-      return false;
-    }
-    // On the face plane: decide by the pull towards the box centre, then lexicographically.
-    const double toCentre = n[0] * (this->TwiceCentre[0] - 2 * x) + n[1] * (this->TwiceCentre[1] - 2 * y) +
-      (faces == 3 ? 0.0 : n[2] * (this->TwiceCentre[2] - 2 * z));
-    if (toCentre < 0)
-    {
-      return false;
-    }
-    if (toCentre == 0)
-    {
-      const bool positive = n[0] > 0 || (n[0] == 0 && (n[1] > 0 || (n[1] == 0 && n[2] > 0)));
-      if (!positive)
-      {
-        return false;
-      }
-    }
-  }
-  return true;
-}
-
 double InterpolateAt(const double* values, const Grid& g, const double index[3])
 {
   int base[3];
