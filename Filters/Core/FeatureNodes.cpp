@@ -224,23 +224,20 @@ void GaussianSmooth(const float* in, float* out, const Grid& g, double sigma, co
       {
         const int j = static_cast<int>(row % ny), k = static_cast<int>(row / ny);
         float* o = dst + row * nx;
+        // Same sum, in the same order, as the loop below would form for every voxel of a row
+        // whose source rows are all constant.
         bool allFlat = true;
+        float exact = 0.f;
         for (int t = -r; t <= r && allFlat; ++t)
         {
           const int jj = alongZ ? j : std::min(ny - 1, std::max(0, j + t));
           const int kk = alongZ ? std::min(nz - 1, std::max(0, k + t)) : k;
-          allFlat = flat[static_cast<std::int64_t>(kk) * ny + jj] != 0;
+          const std::int64_t source = static_cast<std::int64_t>(kk) * ny + jj;
+          allFlat = flat[source] != 0;
+          exact += w[t + r] * level[source];
         }
         if (allFlat)
         {
-          // Same sum, in the same order, as the loop below would form for every voxel.
-          float exact = 0.f;
-          for (int t = -r; t <= r; ++t)
-          {
-            const int jj = alongZ ? j : std::min(ny - 1, std::max(0, j + t));
-            const int kk = alongZ ? std::min(nz - 1, std::max(0, k + t)) : k;
-            exact += w[t + r] * level[static_cast<std::int64_t>(kk) * ny + jj];
-          }
           std::fill(o, o + nx, exact);
           continue;
         }

@@ -229,15 +229,16 @@ TEST(Statistics, MeanAndCountAreExact)
   EXPECT_NEAR(sum, 190.0, 1e-9);
 }
 
-TEST(BoykovJolly, SeparatesTwoPlateausAndHonoursSeeds)
+// A chain of unit nodes with the given values, object seed first, background seed last.
+CutProblem SeededChain(const std::vector<double>& values)
 {
-  // A chain of 20 nodes: values 0 then 10, a seed at each end.
   CutProblem pr;
-  for (int i = 0; i < 20; ++i)
+  const std::int64_t n = static_cast<std::int64_t>(values.size());
+  for (std::int64_t i = 0; i < n; ++i)
   {
-    pr.Value.push_back(i < 8 ? 10.0 : 0.0);
+    pr.Value.push_back(values[i]);
     pr.Size.push_back(1.0);
-    pr.Hard.push_back(i == 0 ? 1 : (i == 19 ? 2 : 0));
+    pr.Hard.push_back(i == 0 ? 1 : (i == n - 1 ? 2 : 0));
     if (i > 0)
     {
       pr.A.push_back(i - 1);
@@ -245,6 +246,18 @@ TEST(BoykovJolly, SeparatesTwoPlateausAndHonoursSeeds)
       pr.Contact.push_back(1.0);
     }
   }
+  return pr;
+}
+
+TEST(BoykovJolly, SeparatesTwoPlateausAndHonoursSeeds)
+{
+  // A chain of 20 nodes: values 10 then 0, a seed at each end.
+  std::vector<double> values;
+  for (int i = 0; i < 20; ++i)
+  {
+    values.push_back(i < 8 ? 10.0 : 0.0);
+  }
+  CutProblem pr = SeededChain(values);
   pr.ObjectSamples = { 10.0, 10.0, 9.5 };
   pr.BackgroundSamples = { 0.0, 0.5, 0.0 };
   const CutResult r = BoykovJollyCut(pr, BoykovJollyParameters());
@@ -259,24 +272,14 @@ TEST(BoykovJolly, SeparatesTwoPlateausAndHonoursSeeds)
 TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
 {
   // Super-nodes of one voxel each: the voxel region term must equal the mean-based one.
-  CutProblem pr;
   std::vector<double> pixels;
   std::vector<std::int64_t> owner;
   for (int i = 0; i < 30; ++i)
   {
-    const double v = (i < 12 ? 10.0 : 0.0) + ((i * 7) % 5) * 0.6;
-    pr.Value.push_back(v);
-    pr.Size.push_back(1.0);
-    pr.Hard.push_back(i == 0 ? 1 : (i == 29 ? 2 : 0));
-    pixels.push_back(v);
+    pixels.push_back((i < 12 ? 10.0 : 0.0) + ((i * 7) % 5) * 0.6);
     owner.push_back(i);
-    if (i > 0)
-    {
-      pr.A.push_back(i - 1);
-      pr.B.push_back(i);
-      pr.Contact.push_back(1.0);
-    }
   }
+  CutProblem pr = SeededChain(pixels);
   pr.ObjectSamples = { 10.0, 11.0, 12.4 };
   pr.BackgroundSamples = { 0.0, 1.2, 2.4 };
   const CutResult byMean = BoykovJollyCut(pr, BoykovJollyParameters());
@@ -297,8 +300,6 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   two.A = { 0, 1 };
   two.B = { 2, 2 };
   two.Contact = { 0.01, 0.01 };
-  two.ObjectSamples = { 10.0, 10.0, 10.0 };
-  two.BackgroundSamples = { 0.0, 0.0, 0.0 };
   const std::vector<double> v = { 10.0, 0.0, 10.0, 10.0, 10.0, 0.0 };
   const std::vector<std::int64_t> o = { 0, 1, 2, 2, 2, 2 };
   two.ObjectSamples = { 10.0, 9.0, 11.0 };
