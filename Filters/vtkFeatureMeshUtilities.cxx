@@ -110,13 +110,17 @@ bool ToValues(vtkDataArray* array, std::vector<T>& values, std::string& error)
     vtkSMPTools::For(0, 64, 1, [&](vtkIdType b0, vtkIdType b1) {
       for (vtkIdType b = b0; b < b1; ++b)
       {
+        // A local count and a raw pointer let the compiler vectorise the conversion.
+        vtkIdType bad = 0;
+        T* out = values.data();
         for (vtkIdType i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
         {
           const double v = static_cast<double>(data[i]);
           const bool ok = std::isfinite(v);
-          badPerBlock[b] += ok ? 0 : 1;
-          values[i] = ok ? static_cast<T>(v) : T(0);
+          bad += ok ? 0 : 1;
+          out[i] = ok ? static_cast<T>(v) : T(0);
         }
+        badPerBlock[b] = bad;
       }
     });
   };

@@ -169,8 +169,10 @@ int vtkFeatureNodes::RequestData(
   const double smoothSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
   this->UpdateProgress(0.15);
 
-  FeatureNodeResult result = ComputeFeatureNodes(smoothed.data(), hessianSmoothed.empty() ? nullptr : hessianSmoothed.data(), edgeInput ? edgeValues.data() : nullptr, grid, p,
-    parallel, AlgorithmProgress(this, 0.15, 0.95));
+  // The unsmoothed values are not needed any more: their buffer becomes the algorithm's workspace.
+  FeatureNodeResult result = ComputeFeatureNodes(smoothed.data(),
+    hessianSmoothed.empty() ? nullptr : hessianSmoothed.data(), edgeInput ? edgeValues.data() : nullptr, grid, p,
+    parallel, AlgorithmProgress(this, 0.15, 0.95), values.data());
   if (result.Aborted)
   {
     return 1;

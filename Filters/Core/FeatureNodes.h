@@ -82,8 +82,10 @@ double RobustMaximum(const float* values, std::int64_t n, double percentile, con
 
 // Canny edges on an already smoothed image: non-maximum suppression along the quantised gradient
 // direction, hysteresis by 8-/26-connectivity. Returns 1 on edge voxels.
+// `magnitudeBuffer`, when given, is n floats of scratch for the gradient magnitude.
 std::vector<std::uint8_t> CannyEdges(const float* smoothed, const Grid& grid, double low, double high,
-  double percentile, const ParallelFor& parallel, double* gradientMaximum = nullptr);
+  double percentile, const ParallelFor& parallel, double* gradientMaximum = nullptr,
+  float* magnitudeBuffer = nullptr);
 
 // PCA sampling radius of each edge point (listed by voxel index).
 std::vector<std::uint8_t> EdgeSampleRadii(const std::vector<std::int64_t>& edgePoints,
@@ -98,18 +100,24 @@ std::vector<std::int64_t> ThinEdgePoints(
 // rho = (max_i |mu_i| / A)^gamma from the Hessian's eigenvalues, A a robust maximum; clipped to 1.
 std::vector<float> HessianFeatureMap(const float* smoothed, const Grid& grid, double gamma, double percentile,
   const ParallelFor& parallel, double* featureMaximum = nullptr);
+// The same into a caller's buffer of n floats.
+void HessianFeatureMap(const float* smoothed, const Grid& grid, double gamma, double percentile,
+  const ParallelFor& parallel, float* rho, double* featureMaximum = nullptr);
 
 // Floyd-Steinberg error diffusion of rho with threshold q: a dot is worth 2q of feature (a midpoint
 // quantiser, q = 0.5 is the classic algorithm), so raising q lowers the dot count. 3D uses half the
 // classic in-slice stencil plus half to the next slice (centre 6/16, its 4-neighbours 2.5/16 each).
 // Returns the voxel indices of the dots.
 std::vector<std::int64_t> Halftone(const std::vector<float>& rho, const Grid& grid, double q);
+std::vector<std::int64_t> Halftone(const float* rho, const Grid& grid, double q);
 
 // The whole recipe on `smoothed` (Canny scale); the Hessian feature map uses `hessianSmoothed`
 // (may be the same image). `edgeMap`, when not null, replaces Canny (non-zero = edge).
+// `workspace`, when given, is n floats the function may overwrite (saves a volume allocation).
 FeatureNodeResult ComputeFeatureNodes(const float* smoothed, const float* hessianSmoothed,
   const std::uint8_t* edgeMap, const Grid& grid,
-  const FeatureNodeParameters& p, const ParallelFor& parallel, const ProgressFunction& progress);
+  const FeatureNodeParameters& p, const ParallelFor& parallel, const ProgressFunction& progress,
+  float* workspace = nullptr);
 
 // Returns an empty string when the parameters are usable, else a sentence saying what is wrong.
 std::string ValidateParameters(const FeatureNodeParameters& p);
