@@ -4,6 +4,7 @@
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
+#include "vtkFloatArray.h"
 #include "vtkNew.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
@@ -149,6 +150,35 @@ bool ToValues(vtkDataArray* array, std::vector<T>& values, std::string& error)
 bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error)
 {
   return ToValues(array, values, error);
+}
+
+const float* FloatValues(vtkDataArray* array, std::vector<float>& storage, std::string& error)
+{
+  vtkFloatArray* floats = vtkFloatArray::SafeDownCast(array);
+  if (floats && floats->GetNumberOfComponents() == 1)
+  {
+    const float* data = floats->GetPointer(0);
+    const vtkIdType n = floats->GetNumberOfTuples();
+    const vtkIdType block = (n + 63) / 64;
+    std::vector<vtkIdType> badPerBlock(64, 0);
+    vtkSMPTools::For(0, 64, 1, [&](vtkIdType b0, vtkIdType b1) {
+      for (vtkIdType b = b0; b < b1; ++b)
+      {
+        vtkIdType bad = 0;
+        for (vtkIdType i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
+        {
+          bad += std::isfinite(data[i]) ? 0 : 1;
+        }
+        badPerBlock[b] = bad;
+      }
+    });
+    if (std::all_of(badPerBlock.begin(), badPerBlock.end(), [](vtkIdType c) { return c == 0; }))
+    {
+      return data;
+    }
+  }
+  // Conversion, or the NaN/Inf error message.
+  return ToFloat(array, storage, error) ? storage.data() : nullptr;
 }
 
 bool ToDouble(vtkDataArray* array, std::vector<double>& values, std::string& error)

@@ -93,14 +93,9 @@ int vtkFeatureNodes::RequestData(
     vtkErrorMacro("Feature Nodes: " << error);
     return 0;
   }
-  if (!(this->GaussianSigma >= 0.0 && this->GaussianSigma <= 50.0) ||
-    !(this->HessianSigma >= 0.0 && this->HessianSigma <= 50.0))
-  {
-    vtkErrorMacro("Feature Nodes: Gaussian and Hessian sigmas must lie in [0, 50] voxels, not "
-      << this->GaussianSigma << " and " << this->HessianSigma << ".");
-    return 0;
-  }
   FeatureNodeParameters p;
+  p.GaussianSigma = this->GaussianSigma;
+  p.HessianSigma = this->HessianSigma;
   p.LowThreshold = this->LowThreshold;
   p.HighThreshold = this->HighThreshold;
   p.MaximumPercentile = this->MaximumPercentile;
@@ -125,7 +120,8 @@ int vtkFeatureNodes::RequestData(
   {
     vtkWarningMacro("Feature Nodes: " << warning);
   }
-  if (!array || !ToFloat(array, values, error))
+  const float* image = array ? FloatValues(array, values, error) : nullptr;
+  if (!image)
   {
     vtkErrorMacro("Feature Nodes: " << error);
     return 0;
@@ -147,8 +143,8 @@ int vtkFeatureNodes::RequestData(
         << grid.Dims[0] << "x" << grid.Dims[1] << "x" << grid.Dims[2] << ").");
       return 0;
     }
-    edgeValues.resize(values.size());
-    for (vtkIdType i = 0; i < static_cast<vtkIdType>(values.size()); ++i)
+    edgeValues.resize(static_cast<size_t>(grid.Size()));
+    for (vtkIdType i = 0; i < static_cast<vtkIdType>(grid.Size()); ++i)
     {
       edgeValues[i] = edgeArray->GetComponent(i, 0) != 0.0 ? 1 : 0;
     }
@@ -156,23 +152,9 @@ int vtkFeatureNodes::RequestData(
   const double prepSeconds = std::chrono::duration<double>(Clock::now() - start).count();
   this->UpdateProgress(0.05);
 
-  // Gaussian smoothing at the Canny scale and at the Hessian scale.
-  auto t0 = Clock::now();
   const ParallelFor parallel = SMPParallelFor();
-  std::vector<float> smoothed(values.size()), hessianSmoothed;
-  GaussianSmooth(values.data(), smoothed.data(), grid, this->GaussianSigma, parallel);
-  if (this->Halftoning && this->HessianSigma != this->GaussianSigma)
-  {
-    hessianSmoothed.resize(values.size());
-    GaussianSmooth(values.data(), hessianSmoothed.data(), grid, this->HessianSigma, parallel);
-  }
-  const double smoothSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  this->UpdateProgress(0.15);
-
-  // The unsmoothed values are not needed any more: their buffer becomes the algorithm's workspace.
-  FeatureNodeResult result = ComputeFeatureNodes(smoothed.data(),
-    hessianSmoothed.empty() ? nullptr : hessianSmoothed.data(), edgeInput ? edgeValues.data() : nullptr, grid, p,
-    parallel, AlgorithmProgress(this, 0.15, 0.95), values.data());
+  FeatureNodeResult result = ComputeFeatureNodes(image, edgeInput ? edgeValues.data() : nullptr, grid, p, parallel,
+    AlgorithmProgress(this, 0.05, 0.95));
   if (result.Aborted)
   {
     return 1;
@@ -228,13 +210,12 @@ int vtkFeatureNodes::RequestData(
   output->GetFieldData()->AddArray(counts);
   vtkNew<vtkDoubleArray> timing;
   timing->SetName("StepSeconds");
-  timing->SetNumberOfComponents(static_cast<int>(result.StepSeconds.size()) + 2);
+  timing->SetNumberOfComponents(static_cast<int>(result.StepSeconds.size()) + 1);
   timing->SetComponentName(0, "prepare");
-  timing->SetComponentName(1, "gaussian");
-  std::vector<double> tuple = { prepSeconds, smoothSeconds };
+  std::vector<double> tuple = { prepSeconds };
   for (size_t s = 0; s < result.StepSeconds.size(); ++s)
   {
-    timing->SetComponentName(static_cast<vtkIdType>(s) + 2, result.StepSeconds[s].first.c_str());
+    timing->SetComponentName(static_cast<vtkIdType>(s) + 1, result.StepSeconds[s].first.c_str());
     tuple.push_back(result.StepSeconds[s].second);
   }
   timing->InsertNextTuple(tuple.data());

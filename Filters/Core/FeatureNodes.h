@@ -1,6 +1,6 @@
 // Feature-sensitive node generation (thesis 2.1 and 4.1): Canny edge points thinned by PCA,
 // halftoning points from a Hessian feature map, uniform fill points and boundary nodes.
-// Works on a Gaussian-smoothed float image in index space; smoothing is the caller's job.
+// Works on a float image in index space.
 #pragma once
 
 #include "Grid.h"
@@ -24,6 +24,9 @@ enum NodeType : std::uint8_t
 
 struct FeatureNodeParameters
 {
+  // Gaussian standard deviations (voxels): before Canny, and before the Hessian of the feature map.
+  double GaussianSigma = 0.7;
+  double HessianSigma = 2.0;
   // Canny hysteresis thresholds, as fractions of a robust maximum of the gradient magnitude.
   double LowThreshold = 0.1;
   double HighThreshold = 0.6;
@@ -111,13 +114,10 @@ void HessianFeatureMap(const float* smoothed, const Grid& grid, double gamma, do
 std::vector<std::int64_t> Halftone(const std::vector<float>& rho, const Grid& grid, double q);
 std::vector<std::int64_t> Halftone(const float* rho, const Grid& grid, double q);
 
-// The whole recipe on `smoothed` (Canny scale); the Hessian feature map uses `hessianSmoothed`
-// (may be the same image). `edgeMap`, when not null, replaces Canny (non-zero = edge).
-// `workspace`, when given, is n floats the function may overwrite (saves a volume allocation).
-FeatureNodeResult ComputeFeatureNodes(const float* smoothed, const float* hessianSmoothed,
-  const std::uint8_t* edgeMap, const Grid& grid,
-  const FeatureNodeParameters& p, const ParallelFor& parallel, const ProgressFunction& progress,
-  float* workspace = nullptr);
+// The whole recipe on `image` (smoothing included). `edgeMap`, when not null, replaces Canny
+// (non-zero = edge).
+FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* edgeMap, const Grid& grid,
+  const FeatureNodeParameters& p, const ParallelFor& parallel, const ProgressFunction& progress);
 
 // Returns an empty string when the parameters are usable, else a sentence saying what is wrong.
 std::string ValidateParameters(const FeatureNodeParameters& p);

@@ -122,7 +122,8 @@ TEST(FeatureNodes, CornersAreNodesAndOneNodePerVoxel)
   const Grid g = Grid2(50, 40);
   const std::vector<float> f = Disk(g, 25, 20, 10);
   FeatureNodeParameters p;
-  const auto r = ComputeFeatureNodes(f.data(), f.data(), nullptr, g, p, SerialFor(), NoProgress());
+  p.GaussianSigma = p.HessianSigma = 0.0; // the disk is used as it is
+  const auto r = ComputeFeatureNodes(f.data(), nullptr, g, p, SerialFor(), NoProgress());
   std::vector<int> seen(g.Size(), 0);
   for (const auto& x : r.Positions)
     EXPECT_EQ(seen[g.Index(x[0], x[1], x[2])]++, 0);
