@@ -404,20 +404,24 @@ double RobustMaximum(const float* v, std::int64_t n, double percentile, const Pa
     return maximum;
   }
   constexpr int bins = 4096;
-  std::vector<std::int64_t> hist(static_cast<size_t>(ReductionBlocks) * bins, 0);
+  // Counts are integers, so any split into blocks gives the same histogram: few blocks on small
+  // images, where merging 64 histograms would cost as much as filling them.
+  const std::int64_t histBlocks = std::max<std::int64_t>(1, std::min<std::int64_t>(ReductionBlocks, n / (16 * bins)));
+  const std::int64_t histBlock = (n + histBlocks - 1) / histBlocks;
+  std::vector<std::int32_t> hist(static_cast<size_t>(histBlocks) * bins, 0);
   const double scale = bins / maximum;
-  parallel(ReductionBlocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+  parallel(histBlocks, 1, [&](std::int64_t b0, std::int64_t b1) {
     for (std::int64_t b = b0; b < b1; ++b)
     {
-      std::int64_t* h = hist.data() + b * bins;
-      for (std::int64_t i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
+      std::int32_t* h = hist.data() + b * bins;
+      for (std::int64_t i = b * histBlock, e = std::min(n, (b + 1) * histBlock); i < e; ++i)
       {
         h[std::min(bins - 1, static_cast<int>(v[i] * scale))]++;
       }
     }
   });
   std::vector<std::int64_t> total(bins, 0);
-  for (std::int64_t b = 0; b < ReductionBlocks; ++b)
+  for (std::int64_t b = 0; b < histBlocks; ++b)
   {
     for (int i = 0; i < bins; ++i)
     {
@@ -465,14 +469,53 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const Grid& g, double low, 
 
   // Non-maximum suppression along the quantised gradient direction; ties resolved by ">" on one
   // side and ">=" on the other, so a two-voxel plateau keeps exactly one voxel.
-  parallel(rows, 16, [&](std::int64_t r0, std::int64_t r1) {
+  parallel(rows, 16, [&, mag](std::int64_t r0, std::int64_t r1) {
+    // Locals, not captured references: the byte stores into `state` may alias anything, and would
+    // force a reload of every captured value per voxel.
+    std::uint8_t* const edgeState = state.data();
+    const float lowV = lowValue, highV = highValue;
     for (std::int64_t r = r0; r < r1; ++r)
     {
       const int j = static_cast<int>(r % g.Dims[1]);
       const int k = static_cast<int>(r / g.Dims[1]);
-      std::int64_t idx = g.Index(0, j, k);
+      const std::int64_t row = g.Index(0, j, k);
+      const bool interiorRow = g.Dims[0] > 2 && j > 0 && j + 1 < g.Dims[1] && (g.Dims[2] == 1 || (k > 0 && k + 1 < g.Dims[2]));
+      if (interiorRow)
+      {
+        // Away from the border: central differences and neighbours without bounds checks (the
+        // same values the general loop below computes).
+        const std::int64_t szz = g.Dims[2] == 1 ? 0 : sz;
+        for (int i = 1; i + 1 < g.Dims[0]; ++i)
+        {
+          const std::int64_t idx = row + i;
+          const float m = mag[idx];
+          if (m < lowV || m <= 0.f)
+          {
+            continue;
+          }
+          const float gx = 0.5f * (f[idx + 1] - f[idx - 1]);
+          const float gy = 0.5f * (f[idx + sy] - f[idx - sy]);
+          const float gz = szz ? 0.5f * (f[idx + szz] - f[idx - szz]) : 0.f;
+          const float amax = std::max(std::fabs(gx), std::max(std::fabs(gy), std::fabs(gz)));
+          const std::int64_t dx = std::fabs(gx) >= tan22 * amax ? (gx > 0 ? 1 : -1) : 0;
+          const std::int64_t dy = std::fabs(gy) >= tan22 * amax ? (gy > 0 ? 1 : -1) : 0;
+          const std::int64_t dz = std::fabs(gz) >= tan22 * amax ? (gz > 0 ? 1 : -1) : 0;
+          const std::int64_t step = dx + dy * sy + dz * szz;
+          if (m > mag[idx + step] && m >= mag[idx - step])
+          {
+            edgeState[idx] = m >= highV ? 2 : 1;
+          }
+        }
+      }
+      std::int64_t idx = row;
       for (int i = 0; i < g.Dims[0]; ++i, ++idx)
       {
+        if (interiorRow && i > 0 && i + 1 < g.Dims[0])
+        {
+          i = g.Dims[0] - 2;
+          idx = row + i;
+          continue;
+        }
         const float m = mag[idx];
         if (m < lowValue || m <= 0.f)
         {
@@ -787,56 +830,89 @@ std::vector<float> HessianFeatureMap(const float* f, const Grid& g, double gamma
   return rho;
 }
 
+inline float LargestAbsEigenvalueInline(float a11, float a22, float a33, float a12, float a13, float a23)
+{
+  // Trigonometric solution of the characteristic cubic (Smith 1961) without trigonometry: for
+  // C = (A - qI)/p the roots are 2cos((acos r)/3 + 2k pi/3), r = det(C)/2. The largest,
+  // 2cos(2 acos(u)/3) with u = sqrt((1+r)/2), is smooth in u on [0,1]: a degree-8 polynomial
+  // (Chebyshev fit, error 9e-9) replaces acos and cos, and the smallest root follows from
+  // c2 + c3 = -c1, c2 c3 = c1^2 - 3. Branch-free, so a row of voxels vectorises; it replaced
+  // Eigen's computeDirect (atan2, sincos), which took 90 of 650 ms on BraTS.
+  const float q = (a11 + a22 + a33) * (1.f / 3.f);
+  const float b11 = a11 - q, b22 = a22 - q, b33 = a33 - q;
+  const float p2 = (b11 * b11 + b22 * b22 + b33 * b33 + 2.f * (a12 * a12 + a13 * a13 + a23 * a23)) * (1.f / 6.f);
+  const float p = std::sqrt(p2);
+  // p = 0 means B = 0: any finite inv then gives C = 0 and both roots q.
+  const float inv = 1.f / std::max(p, 1e-30f);
+  const float c11 = b11 * inv, c22 = b22 * inv, c33 = b33 * inv, c12 = a12 * inv, c13 = a13 * inv, c23 = a23 * inv;
+  const float det = c11 * (c22 * c33 - c23 * c23) - c12 * (c12 * c33 - c23 * c13) + c13 * (c12 * c23 - c22 * c13);
+  const float r = std::min(1.f, std::max(-1.f, 0.5f * det));
+  const float u = std::sqrt(0.5f * (1.f + r));
+  const float g = 0.50000001f +
+    u * (0.57734945f +
+          u * (-0.1110921f +
+                u * (0.05326813f +
+                      u * (-0.03190076f + u * (0.01957721f + u * (-0.01023717f + u * (0.00366753f + u * -0.0006323f)))))));
+  const float c1 = 2.f * g;
+  const float c3 = -0.5f * (c1 + std::sqrt(std::max(0.f, 12.f - 3.f * c1 * c1)));
+  const float largest = q + p * c1, smallest = q + p * c3;
+  return std::max(std::fabs(largest), std::fabs(smallest));
+}
+
+float LargestAbsEigenvalue(float a11, float a22, float a33, float a12, float a13, float a23)
+{
+  return LargestAbsEigenvalueInline(a11, a22, a33, a12, a13, a23);
+}
+
 void HessianFeatureMap(const float* f, const Grid& g, double gamma, double percentile,
   const ParallelFor& parallel, float* rho, double* featureMaximum)
 {
   const std::int64_t n = g.Size();
-  const std::int64_t sy = g.Dims[0], sz = g.SliceStride();
+  const int nx = g.Dims[0];
+  const std::int64_t sy = nx, sz = g.SliceStride();
   const std::int64_t rows = static_cast<std::int64_t>(g.Dims[1]) * g.Dims[2];
   const bool is2D = g.Is2D();
   // Second differences need one voxel on each side: the border keeps rho = 0.
-  parallel(rows, 16, [&](std::int64_t r0, std::int64_t r1) {
+  parallel(rows, 16, [&, f, rho](std::int64_t r0, std::int64_t r1) {
     for (std::int64_t r = r0; r < r1; ++r)
     {
       const int j = static_cast<int>(r % g.Dims[1]);
       const int k = static_cast<int>(r / g.Dims[1]);
-      float* rowOut = rho + g.Index(0, j, k);
-      if (j == 0 || j == g.Dims[1] - 1 || (!is2D && (k == 0 || k == g.Dims[2] - 1)))
+      float* const out = rho + g.Index(0, j, k);
+      if (nx < 3 || j == 0 || j == g.Dims[1] - 1 || (!is2D && (k == 0 || k == g.Dims[2] - 1)))
       {
-        std::fill(rowOut, rowOut + g.Dims[0], 0.f);
+        std::fill(out, out + nx, 0.f);
         continue;
       }
-      rowOut[0] = rowOut[g.Dims[0] - 1] = 0.f;
-      for (int i = 1; i < g.Dims[0] - 1; ++i)
+      out[0] = out[nx - 1] = 0.f;
+      const float* const c = f + g.Index(0, j, k);
+      if (is2D)
       {
-        const std::int64_t c = g.Index(i, j, k);
-        const float v2 = 2.f * f[c];
-        const float hxx = f[c + 1] - v2 + f[c - 1];
-        const float hyy = f[c + sy] - v2 + f[c - sy];
-        const float hxy = 0.25f * (f[c + 1 + sy] - f[c + 1 - sy] - f[c - 1 + sy] + f[c - 1 - sy]);
-        float norm = 0.f;
-        if (is2D)
+        for (int i = 1; i < nx - 1; ++i)
         {
+          const float v2 = 2.f * c[i];
+          const float hxx = c[i + 1] - v2 + c[i - 1];
+          const float hyy = c[i + sy] - v2 + c[i - sy];
+          const float hxy = 0.25f * (c[i + 1 + sy] - c[i + 1 - sy] - c[i - 1 + sy] + c[i - 1 - sy]);
           const float mean = 0.5f * (hxx + hyy);
           const float d = std::sqrt(0.25f * (hxx - hyy) * (hxx - hyy) + hxy * hxy);
-          norm = std::fabs(mean) + d; // max(|mean+d|, |mean-d|)
+          const float norm = std::fabs(mean) + d; // max(|mean+d|, |mean-d|)
+          // NaN and infinities (overflowing differences) give 0, as a comparison that vectorises.
+          out[i] = norm - norm == 0.f ? norm : 0.f;
         }
-        else
-        {
-          const float hzz = f[c + sz] - v2 + f[c - sz];
-          const float hxz = 0.25f * (f[c + 1 + sz] - f[c + 1 - sz] - f[c - 1 + sz] + f[c - 1 - sz]);
-          const float hyz = 0.25f * (f[c + sy + sz] - f[c + sy - sz] - f[c - sy + sz] + f[c - sy - sz]);
-          // Flat regions (e.g. the zero background of skull-stripped MR) skip the eigen-solve.
-          if (hxx != 0.f || hyy != 0.f || hzz != 0.f || hxy != 0.f || hxz != 0.f || hyz != 0.f)
-          {
-            Eigen::Matrix3f h;
-            h << hxx, hxy, hxz, hxy, hyy, hyz, hxz, hyz, hzz;
-            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> es;
-            es.computeDirect(h, Eigen::EigenvaluesOnly);
-            norm = std::max(std::fabs(es.eigenvalues()(0)), std::fabs(es.eigenvalues()(2)));
-          }
-        }
-        rho[c] = std::isfinite(norm) ? norm : 0.f;
+        continue;
+      }
+      for (int i = 1; i < nx - 1; ++i)
+      {
+        const float v2 = 2.f * c[i];
+        const float hxx = c[i + 1] - v2 + c[i - 1];
+        const float hyy = c[i + sy] - v2 + c[i - sy];
+        const float hzz = c[i + sz] - v2 + c[i - sz];
+        const float hxy = 0.25f * (c[i + 1 + sy] - c[i + 1 - sy] - c[i - 1 + sy] + c[i - 1 - sy]);
+        const float hxz = 0.25f * (c[i + 1 + sz] - c[i + 1 - sz] - c[i - 1 + sz] + c[i - 1 - sz]);
+        const float hyz = 0.25f * (c[i + sy + sz] - c[i + sy - sz] - c[i - sy + sz] + c[i - sy - sz]);
+        const float norm = LargestAbsEigenvalueInline(hxx, hyy, hzz, hxy, hxz, hyz);
+        out[i] = norm - norm == 0.f ? norm : 0.f;
       }
     }
   });

@@ -100,6 +100,10 @@ std::vector<std::uint8_t> EdgeSampleRadii(const std::vector<std::int64_t>& edgeP
 std::vector<std::int64_t> ThinEdgePoints(
   const std::vector<std::int64_t>& edgePoints, const std::vector<std::uint8_t>& radii, const Grid& grid);
 
+// max |eigenvalue| of the symmetric 3x3 matrix [a11 a12 a13; a12 a22 a23; a13 a23 a33], to about
+// 1e-6 of the matrix norm.
+float LargestAbsEigenvalue(float a11, float a22, float a33, float a12, float a13, float a23);
+
 // rho = (max_i |mu_i| / A)^gamma from the Hessian's eigenvalues, A a robust maximum; clipped to 1.
 std::vector<float> HessianFeatureMap(const float* smoothed, const Grid& grid, double gamma, double percentile,
   const ParallelFor& parallel, double* featureMaximum = nullptr);

@@ -7,6 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -114,6 +117,31 @@ TEST(Halftone, CountFallsAsThresholdRises)
     const size_t n = Halftone(rho, g, q).size();
     EXPECT_LT(n, previous) << "q = " << q;
     previous = n;
+  }
+}
+
+TEST(Hessian, LargestAbsEigenvalueMatchesEigen)
+{
+  // Random symmetric matrices plus the degenerate cases of the closed form: zero, multiples of
+  // the identity, double roots (r = -1 and r = 1) and rank one.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-100.0, 100.0);
+  std::vector<std::array<double, 6>> cases = { { 0, 0, 0, 0, 0, 0 }, { 3, 3, 3, 0, 0, 0 }, { -2, -2, -2, 0, 0, 0 },
+    { 5, 5, -1, 0, 0, 0 }, { 1, -4, -4, 0, 0, 0 }, { 1, 1, 1, 1, 1, 1 }, { 1e-3, 0, 0, 0, 0, 0 } };
+  for (int t = 0; t < 20000; ++t)
+  {
+    cases.push_back({ { u(rng), u(rng), u(rng), u(rng), u(rng), u(rng) } });
+  }
+  for (const auto& a : cases)
+  {
+    Eigen::Matrix3d m;
+    m << a[0], a[3], a[4], a[3], a[1], a[5], a[4], a[5], a[2];
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(m, Eigen::EigenvaluesOnly);
+    const double want = es.eigenvalues().cwiseAbs().maxCoeff();
+    const double got = LargestAbsEigenvalue(static_cast<float>(a[0]), static_cast<float>(a[1]),
+      static_cast<float>(a[2]), static_cast<float>(a[3]), static_cast<float>(a[4]), static_cast<float>(a[5]));
+    EXPECT_NEAR(got, want, 1e-5 * std::max(1.0, m.norm())) << a[0] << " " << a[1] << " " << a[2] << " " << a[3]
+                                                           << " " << a[4] << " " << a[5];
   }
 }
 
