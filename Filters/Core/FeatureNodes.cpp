@@ -487,6 +487,8 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const Grid& g, double low, 
         const std::int64_t szz = g.Dims[2] == 1 ? 0 : sz;
         for (int i = 1; i + 1 < g.Dims[0]; ++i)
         {
+          // Branch-free past the threshold test (which large flat regions predict well): on noisy
+          // images every direction test is a coin flip for the predictor.
           const std::int64_t idx = row + i;
           const float m = mag[idx];
           if (m < lowV || m <= 0.f)
@@ -495,16 +497,15 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const Grid& g, double low, 
           }
           const float gx = 0.5f * (f[idx + 1] - f[idx - 1]);
           const float gy = 0.5f * (f[idx + sy] - f[idx - sy]);
-          const float gz = szz ? 0.5f * (f[idx + szz] - f[idx - szz]) : 0.f;
+          const float gz = 0.5f * (f[idx + szz] - f[idx - szz]); // 0 in 2D (szz = 0)
           const float amax = std::max(std::fabs(gx), std::max(std::fabs(gy), std::fabs(gz)));
-          const std::int64_t dx = std::fabs(gx) >= tan22 * amax ? (gx > 0 ? 1 : -1) : 0;
-          const std::int64_t dy = std::fabs(gy) >= tan22 * amax ? (gy > 0 ? 1 : -1) : 0;
-          const std::int64_t dz = std::fabs(gz) >= tan22 * amax ? (gz > 0 ? 1 : -1) : 0;
+          const float cut = tan22 * amax;
+          const std::int64_t dx = static_cast<std::int64_t>(std::fabs(gx) >= cut) * ((gx > 0.f) - (gx < 0.f));
+          const std::int64_t dy = static_cast<std::int64_t>(std::fabs(gy) >= cut) * ((gy > 0.f) - (gy < 0.f));
+          const std::int64_t dz = static_cast<std::int64_t>(std::fabs(gz) >= cut) * ((gz > 0.f) - (gz < 0.f));
           const std::int64_t step = dx + dy * sy + dz * szz;
-          if (m > mag[idx + step] && m >= mag[idx - step])
-          {
-            edgeState[idx] = m >= highV ? 2 : 1;
-          }
+          const bool keep = (m > mag[idx + step]) & (m >= mag[idx - step]);
+          edgeState[idx] = static_cast<std::uint8_t>(keep * (1 + (m >= highV)));
         }
       }
       std::int64_t idx = row;
