@@ -661,33 +661,41 @@ std::vector<std::uint8_t> EdgeSampleRadii(const std::vector<std::int64_t>& pts,
   const std::int64_t n = g.Size();
   std::vector<std::uint8_t> result(pts.size());
   parallel(static_cast<std::int64_t>(pts.size()), 256, [&](std::int64_t b, std::int64_t e) {
+    // Locals rather than captures, and scalar accumulators rather than arrays, so that they stay
+    // in registers (they were spilled and reloaded per row).
+    const std::uint8_t* const edges = edgeMap.data();
+    const std::array<std::int32_t, 3>* const table = rowMoments.data();
+    const int nx = g.Dims[0], ny = g.Dims[1], nz = g.Dims[2];
+    const unsigned mask = widthMask;
     for (std::int64_t t = b; t < e; ++t)
     {
       int i, j, k;
       Coordinates(g, pts[t], i, j, k);
-      // Moments relative to the centre point keep the sums small and exact.
-      std::int64_t s[3] = { 0, 0, 0 }, ss[6] = { 0, 0, 0, 0, 0, 0 };
-      std::int64_t count = 0;
-      const int k0 = std::max(0, k - h), k1 = std::min(g.Dims[2] - 1, k + h);
-      const int j0 = std::max(0, j - h), j1 = std::min(g.Dims[1] - 1, j + h);
-      const int i0 = std::max(0, i - h), i1 = std::min(g.Dims[0] - 1, i + h);
+      // Moments relative to the centre point keep the sums small and exact (integers).
+      std::int64_t count = 0, s0 = 0, s1 = 0, s2 = 0, q0 = 0, q1 = 0, q2 = 0, q3 = 0, q4 = 0, q5 = 0;
+      const int k0 = std::max(0, k - h), k1 = std::min(nz - 1, k + h);
+      const int j0 = std::max(0, j - h), j1 = std::min(ny - 1, j + h);
+      const int i0 = std::max(0, i - h), i1 = std::min(nx - 1, i + h);
+      const bool packed = useTable && i - h >= 0 && i + h < nx;
       for (int kk = k0; kk <= k1; ++kk)
       {
         const std::int64_t z = kk - k;
+        // Per-slice sums: count, x, x^2, y, y^2, xy.
+        std::int64_t C = 0, X = 0, XX = 0, YC = 0, YYC = 0, YX = 0;
         for (int jj = j0; jj <= j1; ++jj)
         {
           const std::int64_t y = jj - j;
-          const std::uint8_t* row = edgeMap.data() + g.Index(0, jj, kk);
+          const std::int64_t rowStart = g.Index(0, jj, kk);
+          const std::uint8_t* row = edges + rowStart;
           std::int64_t c = 0, sx = 0, sxx = 0;
           if (useTable)
           {
             unsigned bits = 0;
-            const std::int64_t from = (row - edgeMap.data()) + i - h;
-            if (i - h >= 0 && i + h < g.Dims[0] && from + 16 <= n)
+            const std::int64_t from = rowStart + i - h;
+            if (packed && from + 16 <= n)
             {
               // Interior row: two 8-byte loads, each packed to 8 bits (bytes are 0 or 1).
-              bits = static_cast<unsigned>(PackBytes(edgeMap.data() + from) |
-                                           PackBytes(edgeMap.data() + from + 8) << 8) & widthMask;
+              bits = static_cast<unsigned>(PackBytes(edges + from) | PackBytes(edges + from + 8) << 8) & mask;
             }
             else
             {
@@ -696,7 +704,7 @@ std::vector<std::uint8_t> EdgeSampleRadii(const std::vector<std::int64_t>& pts,
                 bits |= static_cast<unsigned>(row[ii] != 0) << (ii - i + h);
               }
             }
-            const auto& m = rowMoments[bits];
+            const auto& m = table[bits];
             c = m[0];
             sx = m[1];
             sxx = m[2];
@@ -711,18 +719,25 @@ std::vector<std::uint8_t> EdgeSampleRadii(const std::vector<std::int64_t>& pts,
               sxx += on * x * x;
             }
           }
-          count += c;
-          s[0] += sx;
-          s[1] += y * c;
-          s[2] += z * c;
-          ss[0] += sxx;
-          ss[1] += y * y * c;
-          ss[2] += z * z * c;
-          ss[3] += y * sx;
-          ss[4] += z * sx;
-          ss[5] += y * z * c;
+          C += c;
+          X += sx;
+          XX += sxx;
+          YC += y * c;
+          YYC += y * y * c;
+          YX += y * sx;
         }
+        count += C;
+        s0 += X;
+        s1 += YC;
+        s2 += z * C;
+        q0 += XX;
+        q1 += YYC;
+        q2 += z * z * C;
+        q3 += YX;
+        q4 += z * X;
+        q5 += z * YC;
       }
+      const std::int64_t s[3] = { s0, s1, s2 }, ss[6] = { q0, q1, q2, q3, q4, q5 };
       int cls = 2; // curved, corner or speck: densest sampling
       if (count > g.Dimension())
       {
