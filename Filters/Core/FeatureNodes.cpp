@@ -793,6 +793,43 @@ std::vector<std::int64_t> ThinEdgePoints(
     order[first[radii[t]]++] = static_cast<std::int64_t>(t);
   }
 
+  // Small radii (all the defaults): a map of the Chebyshev distance to the nearest kept point,
+  // capped past the largest radius, stamped around each kept point. A point is blocked exactly when
+  // that distance is at most its radius: one lookup per query (BraTS thinning 43 -> 25 ms).
+  const int largest = radii.empty() ? 0 : *std::max_element(radii.begin(), radii.end());
+  constexpr int maxStampRadius = 8;
+  if (largest <= maxStampRadius)
+  {
+    const std::uint8_t far = static_cast<std::uint8_t>(largest + 1);
+    std::vector<std::uint8_t> distance(static_cast<std::size_t>(g.Size()), far);
+    std::vector<std::int64_t> kept;
+    const int kr = g.Is2D() ? 0 : largest;
+    for (std::int64_t t : order)
+    {
+      if (distance[pts[t]] <= radii[t])
+      {
+        continue;
+      }
+      kept.push_back(t);
+      int i, j, k;
+      Coordinates(g, pts[t], i, j, k);
+      for (int dk = std::max(-kr, -k); dk <= std::min(kr, g.Dims[2] - 1 - k); ++dk)
+      {
+        for (int dj = std::max(-largest, -j); dj <= std::min(largest, g.Dims[1] - 1 - j); ++dj)
+        {
+          std::uint8_t* row = distance.data() + g.Index(0, j + dj, k + dk);
+          const int dkj = std::max(std::abs(dk), std::abs(dj));
+          for (int di = std::max(-largest, -i); di <= std::min(largest, g.Dims[0] - 1 - i); ++di)
+          {
+            const std::uint8_t d = static_cast<std::uint8_t>(std::max(dkj, std::abs(di)));
+            row[i + di] = std::min(row[i + di], d);
+          }
+        }
+      }
+    }
+    return kept;
+  }
+
   // Bucket grid of kept points, so that a query looks at a few cells instead of a (2R+1)^3 box.
   constexpr int cell = 4;
   const int cx = (g.Dims[0] + cell - 1) / cell, cy = (g.Dims[1] + cell - 1) / cell,

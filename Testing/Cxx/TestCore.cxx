@@ -9,8 +9,10 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <numeric>
 #include <random>
 
 using namespace featuremesh;
@@ -102,6 +104,54 @@ TEST(PCA, ThinningKeepsCornerAndSpacesLine)
   EXPECT_EQ(kept[0], 12);
   EXPECT_LE(kept.size(), 30u / 5 + 2);
   EXPECT_GE(kept.size(), 30u / 6);
+}
+
+TEST(PCA, ThinningMatchesTheGreedyDefinition)
+{
+  // Random 3D points, radii up to 4 (the distance-map path) and up to 12 (the bucket-grid path),
+  // against the O(n^2) definition: visit by (radius, index); keep a point when no kept point lies
+  // within its (2R+1)-box.
+  Grid g;
+  g.Dims = { { 40, 30, 20 } };
+  std::mt19937 rng(3);
+  for (int largest : { 4, 12 })
+  {
+    std::vector<std::int64_t> pts;
+    std::vector<std::uint8_t> radii;
+    std::uniform_int_distribution<std::int64_t> voxel(0, g.Size() - 1);
+    std::uniform_int_distribution<int> radius(0, largest);
+    std::vector<char> used(g.Size(), 0);
+    while (pts.size() < 600)
+    {
+      const std::int64_t v = voxel(rng);
+      if (!used[v]++)
+      {
+        pts.push_back(v);
+        radii.push_back(static_cast<std::uint8_t>(radius(rng)));
+      }
+    }
+    std::vector<std::int64_t> order(pts.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](std::int64_t a, std::int64_t b) { return radii[a] < radii[b]; });
+    auto xyz = [&](std::int64_t v) {
+      return std::array<std::int64_t, 3>{ { v % 40, (v / 40) % 30, v / 1200 } };
+    };
+    std::vector<std::int64_t> want;
+    for (std::int64_t t : order)
+    {
+      bool blocked = false;
+      for (std::int64_t q : want)
+      {
+        const auto a = xyz(pts[t]), b = xyz(pts[q]);
+        blocked |= std::abs(a[0] - b[0]) <= radii[t] && std::abs(a[1] - b[1]) <= radii[t] && std::abs(a[2] - b[2]) <= radii[t];
+      }
+      if (!blocked)
+      {
+        want.push_back(t);
+      }
+    }
+    EXPECT_EQ(ThinEdgePoints(pts, radii, g), want) << "radii up to " << largest;
+  }
 }
 
 TEST(Halftone, CountFallsAsThresholdRises)
