@@ -37,6 +37,11 @@ ParallelFor SMPParallelFor()
     {
       return;
     }
+    // VTK 9.2's STDThread backend starts its threads on every For and queues one job per grain
+    // under a lock: two jobs per thread at least. Loops here balance well, and their results do
+    // not depend on the split.
+    const std::int64_t threads = std::max(1, vtkSMPTools::GetEstimatedNumberOfThreads());
+    grain = std::max(grain, (n + 2 * threads - 1) / (2 * threads));
     vtkSMPTools::For(0, static_cast<vtkIdType>(n), static_cast<vtkIdType>(grain),
       [&f](vtkIdType b, vtkIdType e) { f(b, e); });
   };
