@@ -40,6 +40,17 @@ inline float Diff(const float* f, std::int64_t idx, int coord, int dim, std::int
   return 0.5f * (f[idx + stride] - f[idx - stride]);
 }
 
+// The gradient direction quantised to one of the 8 (2D) or 26 (3D) neighbour steps: a component
+// is kept, with its sign, when it is at least tan(22.5 deg) of the largest. Branch-free: on noisy
+// images every test is a coin flip for the branch predictor.
+inline std::array<int, 3> QuantisedDirection(float gx, float gy, float gz)
+{
+  constexpr float tan22 = 0.41421356f;
+  const float cut = tan22 * std::max(std::fabs(gx), std::max(std::fabs(gy), std::fabs(gz)));
+  auto component = [cut](float v) { return static_cast<int>(std::fabs(v) >= cut) * ((v > 0.f) - (v < 0.f)); };
+  return { { component(gx), component(gy), component(gz) } };
+}
+
 inline void Coordinates(const Grid& g, std::int64_t idx, int& i, int& j, int& k)
 {
   const std::int64_t slice = g.SliceStride();
@@ -171,8 +182,8 @@ inline bool ConstantRow(const float* x, int n)
 
 // One Gaussian pass along x, row by row through a padded copy (borders replicated). Constant
 // rows (the flat background of skull-stripped MR, padding) get the same sum the convolution would
-// form, without convolving.
-void SmoothRowX(const float* src, float* dst, int nx, const std::vector<float>& w, std::vector<float>& pad)
+// form, without convolving. Returns whether the smoothed row is constant.
+bool SmoothRowX(const float* src, float* dst, int nx, const std::vector<float>& w, std::vector<float>& pad)
 {
   const int r = static_cast<int>(w.size() / 2);
   if (ConstantRow(src, nx))
@@ -183,7 +194,7 @@ void SmoothRowX(const float* src, float* dst, int nx, const std::vector<float>& 
       acc += w[t] * src[0];
     }
     std::fill(dst, dst + nx, acc);
-    return;
+    return true;
   }
   for (int i = 0; i < nx + 2 * r; ++i)
   {
@@ -201,21 +212,24 @@ void SmoothRowX(const float* src, float* dst, int nx, const std::vector<float>& 
       dst[i] += wt * p[i];
     }
   }
+  return ConstantRow(dst, nx);
 }
 
-// One Gaussian pass across rows: output row `o` from the 2r+1 rows row(t), t = -r..r (the caller
-// clamps), whole rows weighted and added so the inner loop runs along contiguous memory. When all
-// source rows are constant, the same sum in the same order fills the row.
-template <typename RowOf>
-void SmoothAcrossRows(float* o, int nx, const std::vector<float>& w, const RowOf& row, const std::uint8_t* flat)
+// One Gaussian pass across a stack of `count` rows of nx values (row q at rows + q * nx, `flat[q]`
+// when it is constant): output row `o` from rows o-r..o+r, borders replicated, whole rows weighted
+// and added so the inner loop runs along contiguous memory. When all source rows are constant, the
+// same sum in the same order fills the row.
+void SmoothAcrossRows(float* o, int nx, const std::vector<float>& w, const float* rows, const std::uint8_t* flat,
+  int count, int index)
 {
   const int r = static_cast<int>(w.size() / 2);
+  auto source = [&](int t) { return std::min(count - 1, std::max(0, index + t)); };
   bool allFlat = true;
   float exact = 0.f;
   for (int t = -r; t <= r && allFlat; ++t)
   {
-    allFlat = flat[t + r] != 0;
-    exact += w[t + r] * row(t)[0];
+    allFlat = flat[source(t)] != 0;
+    exact += w[t + r] * rows[static_cast<std::int64_t>(source(t)) * nx];
   }
   if (allFlat)
   {
@@ -225,7 +239,7 @@ void SmoothAcrossRows(float* o, int nx, const std::vector<float>& w, const RowOf
   std::fill(o, o + nx, 0.f);
   for (int t = -r; t <= r; ++t)
   {
-    const float* s = row(t);
+    const float* s = rows + static_cast<std::int64_t>(source(t)) * nx;
     const float wt = w[t + r];
     for (int i = 0; i < nx; ++i)
     {
@@ -256,32 +270,6 @@ void GaussianSmooth(const float* in, float* out, const Grid& g, double sigma, co
   }
   const int nx = g.Dims[0], ny = g.Dims[1], nz = g.Dims[2];
   const std::int64_t slice = g.SliceStride();
-  auto clamp = [](int v, int last) { return std::min(last, std::max(0, v)); };
-
-  // x and y, one slice at a time in a slice-sized buffer that stays in cache; no volume-sized
-  // temporary (a fresh 36 MB buffer costs ~20 ms of page faults on these machines).
-  auto smoothSliceXY = [&](int k, std::vector<float>& xs, std::vector<float>& pad, std::vector<std::uint8_t>& flat,
-                         int j0, int j1, bool doX) {
-    const float* src = in + k * slice;
-    if (doX)
-    {
-      for (int j = 0; j < ny; ++j)
-      {
-        SmoothRowX(src + static_cast<std::int64_t>(j) * nx, xs.data() + static_cast<std::int64_t>(j) * nx, nx, w, pad);
-        flat[j] = ConstantRow(xs.data() + static_cast<std::int64_t>(j) * nx, nx) ? 1 : 0;
-      }
-    }
-    std::vector<std::uint8_t> rowFlat(2 * r + 1);
-    for (int j = j0; j < j1; ++j)
-    {
-      for (int t = -r; t <= r; ++t)
-      {
-        rowFlat[t + r] = flat[clamp(j + t, ny - 1)];
-      }
-      SmoothAcrossRows(out + k * slice + static_cast<std::int64_t>(j) * nx, nx, w,
-        [&](int t) { return xs.data() + static_cast<std::int64_t>(clamp(j + t, ny - 1)) * nx; }, rowFlat.data());
-    }
-  };
   if (nz == 1)
   {
     // 2D: the x pass over all rows in parallel, then the y pass in parallel.
@@ -291,29 +279,40 @@ void GaussianSmooth(const float* in, float* out, const Grid& g, double sigma, co
       std::vector<float> pad(nx + 2 * r);
       for (std::int64_t j = j0; j < j1; ++j)
       {
-        SmoothRowX(in + j * nx, xs.data() + j * nx, nx, w, pad);
-        flat[j] = ConstantRow(xs.data() + j * nx, nx) ? 1 : 0;
+        flat[j] = SmoothRowX(in + j * nx, xs.data() + j * nx, nx, w, pad);
       }
     });
     parallel(ny, 16, [&](std::int64_t j0, std::int64_t j1) {
-      std::vector<float> pad;
-      smoothSliceXY(0, xs, pad, flat, static_cast<int>(j0), static_cast<int>(j1), false);
+      for (std::int64_t j = j0; j < j1; ++j)
+      {
+        SmoothAcrossRows(out + j * nx, nx, w, xs.data(), flat.data(), ny, static_cast<int>(j));
+      }
     });
     return;
   }
+  // x and y, one slice at a time in a slice-sized buffer that stays in cache; no volume-sized
+  // temporary (a fresh 36 MB buffer costs ~20 ms of page faults on these machines).
   parallel(nz, 1, [&](std::int64_t k0, std::int64_t k1) {
     std::vector<float> xs(slice), pad(nx + 2 * r);
     std::vector<std::uint8_t> flat(ny);
     for (std::int64_t k = k0; k < k1; ++k)
     {
-      smoothSliceXY(static_cast<int>(k), xs, pad, flat, 0, ny, true);
+      for (int j = 0; j < ny; ++j)
+      {
+        flat[j] = SmoothRowX(in + k * slice + static_cast<std::int64_t>(j) * nx,
+          xs.data() + static_cast<std::int64_t>(j) * nx, nx, w, pad);
+      }
+      for (int j = 0; j < ny; ++j)
+      {
+        SmoothAcrossRows(out + k * slice + static_cast<std::int64_t>(j) * nx, nx, w, xs.data(), flat.data(), ny, j);
+      }
     }
   });
   // z, in place: each task copies the column of rows it owns (all k for one j) into a private
   // buffer, then writes the smoothed rows back.
   parallel(ny, 1, [&](std::int64_t j0, std::int64_t j1) {
     std::vector<float> column(static_cast<std::size_t>(nz) * nx);
-    std::vector<std::uint8_t> flat(nz), rowFlat(2 * r + 1);
+    std::vector<std::uint8_t> flat(nz);
     for (std::int64_t j = j0; j < j1; ++j)
     {
       for (int k = 0; k < nz; ++k)
@@ -324,13 +323,7 @@ void GaussianSmooth(const float* in, float* out, const Grid& g, double sigma, co
       }
       for (int k = 0; k < nz; ++k)
       {
-        for (int t = -r; t <= r; ++t)
-        {
-          rowFlat[t + r] = flat[clamp(k + t, nz - 1)];
-        }
-        SmoothAcrossRows(out + k * slice + j * nx, nx, w,
-          [&](int t) { return column.data() + static_cast<std::int64_t>(clamp(k + t, nz - 1)) * nx; },
-          rowFlat.data());
+        SmoothAcrossRows(out + k * slice + j * nx, nx, w, column.data(), flat.data(), nz, k);
       }
     }
   });
@@ -464,8 +457,6 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const Grid& g, double low, 
   const float highValue = static_cast<float>(high * gmax);
   const std::int64_t sy = g.Dims[0], sz = g.SliceStride();
   const std::int64_t rows = static_cast<std::int64_t>(g.Dims[1]) * g.Dims[2];
-  // A quantised direction component is kept when it is at least tan(22.5 deg) of the largest one.
-  constexpr float tan22 = 0.41421356f;
 
   // Non-maximum suppression along the quantised gradient direction; ties resolved by ">" on one
   // side and ">=" on the other, so a two-voxel plateau keeps exactly one voxel.
@@ -487,8 +478,7 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const Grid& g, double low, 
         const std::int64_t szz = g.Dims[2] == 1 ? 0 : sz;
         for (int i = 1; i + 1 < g.Dims[0]; ++i)
         {
-          // Branch-free past the threshold test (which large flat regions predict well): on noisy
-          // images every direction test is a coin flip for the predictor.
+          // Branch-free past the threshold test, which large flat regions predict well.
           const std::int64_t idx = row + i;
           const float m = mag[idx];
           if (m < lowV || m <= 0.f)
@@ -498,12 +488,8 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const Grid& g, double low, 
           const float gx = 0.5f * (f[idx + 1] - f[idx - 1]);
           const float gy = 0.5f * (f[idx + sy] - f[idx - sy]);
           const float gz = 0.5f * (f[idx + szz] - f[idx - szz]); // 0 in 2D (szz = 0)
-          const float amax = std::max(std::fabs(gx), std::max(std::fabs(gy), std::fabs(gz)));
-          const float cut = tan22 * amax;
-          const std::int64_t dx = static_cast<std::int64_t>(std::fabs(gx) >= cut) * ((gx > 0.f) - (gx < 0.f));
-          const std::int64_t dy = static_cast<std::int64_t>(std::fabs(gy) >= cut) * ((gy > 0.f) - (gy < 0.f));
-          const std::int64_t dz = static_cast<std::int64_t>(std::fabs(gz) >= cut) * ((gz > 0.f) - (gz < 0.f));
-          const std::int64_t step = dx + dy * sy + dz * szz;
+          const std::array<int, 3> d = QuantisedDirection(gx, gy, gz);
+          const std::int64_t step = d[0] + d[1] * sy + d[2] * szz;
           const bool keep = (m > mag[idx + step]) & (m >= mag[idx - step]);
           edgeState[idx] = static_cast<std::uint8_t>(keep * (1 + (m >= highV)));
         }
@@ -525,10 +511,8 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const Grid& g, double low, 
         const float gx = Diff(f, idx, i, g.Dims[0], 1);
         const float gy = Diff(f, idx, j, g.Dims[1], sy);
         const float gz = Diff(f, idx, k, g.Dims[2], sz);
-        const float amax = std::max(std::fabs(gx), std::max(std::fabs(gy), std::fabs(gz)));
-        const int dx = std::fabs(gx) >= tan22 * amax ? (gx > 0 ? 1 : -1) : 0;
-        const int dy = std::fabs(gy) >= tan22 * amax ? (gy > 0 ? 1 : -1) : 0;
-        const int dz = std::fabs(gz) >= tan22 * amax ? (gz > 0 ? 1 : -1) : 0;
+        const std::array<int, 3> d = QuantisedDirection(gx, gy, gz);
+        const int dx = d[0], dy = d[1], dz = d[2];
         float ahead = 0.f, behind = 0.f;
         if (g.Contains(i + dx, j + dy, k + dz))
         {
@@ -737,19 +721,18 @@ std::vector<std::uint8_t> EdgeSampleRadii(const std::vector<std::int64_t>& pts,
         q4 += z * X;
         q5 += z * YC;
       }
-      const std::int64_t s[3] = { s0, s1, s2 }, ss[6] = { q0, q1, q2, q3, q4, q5 };
       int cls = 2; // curved, corner or speck: densest sampling
       if (count > g.Dimension())
       {
         const double c = static_cast<double>(count);
-        const double m0 = static_cast<double>(s[0]), m1 = static_cast<double>(s[1]), m2 = static_cast<double>(s[2]);
+        const double m0 = static_cast<double>(s0), m1 = static_cast<double>(s1), m2 = static_cast<double>(s2);
         Eigen::Matrix3d cov;
-        cov(0, 0) = static_cast<double>(ss[0]) / c - m0 * m0 / (c * c);
-        cov(1, 1) = static_cast<double>(ss[1]) / c - m1 * m1 / (c * c);
-        cov(2, 2) = static_cast<double>(ss[2]) / c - m2 * m2 / (c * c);
-        cov(0, 1) = cov(1, 0) = static_cast<double>(ss[3]) / c - m0 * m1 / (c * c);
-        cov(0, 2) = cov(2, 0) = static_cast<double>(ss[4]) / c - m0 * m2 / (c * c);
-        cov(1, 2) = cov(2, 1) = static_cast<double>(ss[5]) / c - m1 * m2 / (c * c);
+        cov(0, 0) = static_cast<double>(q0) / c - m0 * m0 / (c * c);
+        cov(1, 1) = static_cast<double>(q1) / c - m1 * m1 / (c * c);
+        cov(2, 2) = static_cast<double>(q2) / c - m2 * m2 / (c * c);
+        cov(0, 1) = cov(1, 0) = static_cast<double>(q3) / c - m0 * m1 / (c * c);
+        cov(0, 2) = cov(2, 0) = static_cast<double>(q4) / c - m0 * m2 / (c * c);
+        cov(1, 2) = cov(2, 1) = static_cast<double>(q5) / c - m1 * m2 / (c * c);
         double ratio = 1.0;
         if (is2D)
         {
@@ -875,14 +858,6 @@ std::vector<std::int64_t> ThinEdgePoints(
   return kept;
 }
 
-std::vector<float> HessianFeatureMap(const float* f, const Grid& g, double gamma, double percentile,
-  const ParallelFor& parallel, double* featureMaximum)
-{
-  std::vector<float> rho(g.Size());
-  HessianFeatureMap(f, g, gamma, percentile, parallel, rho.data(), featureMaximum);
-  return rho;
-}
-
 inline float LargestAbsEigenvalueInline(float a11, float a22, float a33, float a12, float a13, float a23)
 {
   // Trigonometric solution of the characteristic cubic (Smith 1961) without trigonometry: for
@@ -988,11 +963,6 @@ void HessianFeatureMap(const float* f, const Grid& g, double gamma, double perce
       rho[i] = gam == 1.f ? v : std::pow(v, gam);
     }
   });
-}
-
-std::vector<std::int64_t> Halftone(const std::vector<float>& rho, const Grid& g, double q)
-{
-  return Halftone(rho.data(), g, q);
 }
 
 std::vector<std::int64_t> Halftone(const float* rho, const Grid& g, double q)
@@ -1237,12 +1207,11 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
   // 5. Uniform lattice points where no edge voxel and no node lies within the window.
   t0 = Clock::now();
   {
-    // Edge voxels count as busy: no uniform point near them (and none lands on one, as the
-    // window around a uniform point is free of them).
-    std::vector<std::uint8_t>& busy = occupied;
+    // Edge voxels count as occupied from here: no uniform point near them (and none lands on one,
+    // as the window around a uniform point is free of them).
     for (std::int64_t i = 0; i < n; ++i)
     {
-      busy[i] |= out.EdgeMap[i];
+      occupied[i] |= out.EdgeMap[i];
     }
     const int s = p.UniformSpacing;
     const int start = s / 2;
@@ -1252,7 +1221,7 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
       {
         for (int i = start; i < g.Dims[0]; i += s)
         {
-          if (!AnyInBox(busy, g, i, j, k, h))
+          if (!AnyInBox(occupied, g, i, j, k, h))
           {
             add(i, j, k, NodeUniform, 0.5f * s);
           }

@@ -105,9 +105,7 @@ std::vector<std::int64_t> ThinEdgePoints(
 float LargestAbsEigenvalue(float a11, float a22, float a33, float a12, float a13, float a23);
 
 // rho = (max_i |mu_i| / A)^gamma from the Hessian's eigenvalues, A a robust maximum; clipped to 1.
-std::vector<float> HessianFeatureMap(const float* smoothed, const Grid& grid, double gamma, double percentile,
-  const ParallelFor& parallel, double* featureMaximum = nullptr);
-// The same into a caller's buffer of n floats.
+// Written into a caller's buffer of n floats.
 void HessianFeatureMap(const float* smoothed, const Grid& grid, double gamma, double percentile,
   const ParallelFor& parallel, float* rho, double* featureMaximum = nullptr);
 
@@ -115,7 +113,6 @@ void HessianFeatureMap(const float* smoothed, const Grid& grid, double gamma, do
 // quantiser, q = 0.5 is the classic algorithm), so raising q lowers the dot count. 3D uses half the
 // classic in-slice stencil plus half to the next slice (centre 6/16, its 4-neighbours 2.5/16 each).
 // Returns the voxel indices of the dots.
-std::vector<std::int64_t> Halftone(const std::vector<float>& rho, const Grid& grid, double q);
 std::vector<std::int64_t> Halftone(const float* rho, const Grid& grid, double q);
 
 // The whole recipe on `image` (smoothing included). `edgeMap`, when not null, replaces Canny

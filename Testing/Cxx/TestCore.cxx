@@ -164,7 +164,7 @@ TEST(Halftone, CountFallsAsThresholdRises)
   size_t previous = SIZE_MAX;
   for (double q : { 0.1, 0.2, 0.3, 0.5, 0.7, 0.9 })
   {
-    const size_t n = Halftone(rho, g, q).size();
+    const size_t n = Halftone(rho.data(), g, q).size();
     EXPECT_LT(n, previous) << "q = " << q;
     previous = n;
   }
