@@ -1,0 +1,123 @@
+"""FeatureMesh from pvpython: plugin lookup, cases, seeds, the pipeline, Dice.
+
+One place for the glue the main script, the benchmarks and the tests share:
+
+    import featuremesh as fm
+    fm.load_plugin()                      # $FEATUREMESH_PLUGIN, else build/**/FeatureMesh.so
+    case = fm.Case(fm.case_dir("nuclei-dsb2018"))
+    cut = case.super_voxel_cut(case.mesh(case.feature_nodes()))
+    print(fm.dice(fm.labels(cut), case.truth()))
+"""
+import glob
+import os
+
+import numpy as np
+from paraview import servermanager as sm
+import paraview.simple as ps
+from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+DATA = os.environ.get("FEATUREMESH_DATA", os.path.join(ROOT, "Data"))
+SHARED = os.environ.get("FEATUREMESH_SHARED_DATA", os.path.join(os.path.dirname(ROOT), "shared", "data"))
+
+__all__ = ["ROOT", "DATA", "SHARED", "np", "v2n", "find_plugin", "load_plugin", "cases", "case_dir", "seeds", "fetch",
+           "labels", "dice", "Case"]
+
+
+def find_plugin():
+    """$FEATUREMESH_PLUGIN, else the plugin in the repository's build/ tree."""
+    path = os.environ.get("FEATUREMESH_PLUGIN")
+    if path:
+        return path
+    hits = sorted(glob.glob(os.path.join(ROOT, "build", "**", "FeatureMesh.so"), recursive=True))
+    if not hits:
+        raise SystemExit("FeatureMesh.so not found: build the project (bash scripts/setup.sh) or set FEATUREMESH_PLUGIN")
+    return hits[0]
+
+
+_loaded = []
+
+
+def load_plugin(path=None, ns=None):
+    """Loads the plugin once; its filters join paraview.simple (and `ns` when given)."""
+    if not _loaded:
+        ps.LoadPlugin(path or find_plugin(), ns=None)
+        _loaded.append(True)
+    if ns is not None:
+        for name in ("FeatureNodes", "DelaunayImageMesh", "SuperVoxelCut", "VoxelCut"):
+            ns[name] = getattr(ps, name)
+
+
+def cases(selection=()):
+    """{name: folder} of the bundled cases, then those of the shared data; `selection` filters by name."""
+    found = {}
+    for root in (DATA, os.path.join(SHARED, "cases")):
+        for image in sorted(glob.glob(os.path.join(root, "*", "image.mha"))):
+            found.setdefault(os.path.basename(os.path.dirname(image)), os.path.dirname(image))
+    return {k: v for k, v in found.items() if not selection or k in selection}
+
+
+def case_dir(name):
+    """The folder of case `name` (bundled first), or None."""
+    return cases([name]).get(name)
+
+
+def seeds(arg):
+    """A point-set proxy from a CSV file (columns x,y,z, world coordinates) or from "x,y,z;x,y,z"."""
+    if os.path.isfile(arg):
+        return ps.TableToPoints(Input=ps.CSVReader(FileName=[arg]), XColumn="x", YColumn="y", ZColumn="z")
+    coords = [float(v) for p in arg.split(";") if p.strip() for v in p.split(",")]
+    return ps.PolyPointSource(Points=coords)
+
+
+def fetch(proxy, port=0):
+    return sm.Fetch(proxy, idx=port)
+
+
+def labels(cut, port=2):
+    """The label image of a cut proxy (Super-Voxel Cut port 2, or Voxel Cut port 0) as a flat array."""
+    return v2n(fetch(cut, port).GetPointData().GetScalars())
+
+
+def dice(a, b):
+    a, b = np.asarray(a).astype(bool), np.asarray(b).astype(bool)
+    return 2.0 * (a & b).sum() / max(1, a.sum() + b.sum())
+
+
+class Case:
+    """A case folder (image.mha, seeds_object.csv, seeds_background.csv, optional truth.mha) and its
+    pipeline with fresh proxies on every call; properties pass through as keyword arguments."""
+
+    def __init__(self, folder, image=None, object_seeds=None, background_seeds=None):
+        self.folder = folder
+        self.name = os.path.basename(os.path.normpath(folder))
+        self.image = ps.OpenDataFile(image or os.path.join(folder, "image.mha"))
+        self.image.UpdatePipeline()
+        self.scalars = ["POINTS", self.image.PointData.keys()[0]]
+        self.object_seeds = seeds(object_seeds or os.path.join(folder, "seeds_object.csv"))
+        self.background_seeds = seeds(background_seeds or os.path.join(folder, "seeds_background.csv"))
+        self.is3d = fetch(self.image).GetDimensions()[2] > 1
+
+    def truth(self):
+        path = os.path.join(self.folder, "truth.mha")
+        return v2n(fetch(ps.OpenDataFile(path)).GetPointData().GetScalars()) if os.path.isfile(path) else None
+
+    def feature_nodes(self, **properties):
+        return ps.FeatureNodes(Input=self.image, Scalars=self.scalars, **properties)
+
+    def mesh(self, nodes, **properties):
+        return ps.DelaunayImageMesh(Nodes=nodes, Image=self.image, Scalars=self.scalars, **properties)
+
+    def super_voxel_cut(self, mesh, **properties):
+        return ps.SuperVoxelCut(Mesh=mesh, ObjectSeeds=self.object_seeds, BackgroundSeeds=self.background_seeds,
+                                Image=self.image, Scalars=self.scalars, **properties)
+
+    def voxel_cut(self, **properties):
+        return ps.VoxelCut(Input=self.image, ObjectSeeds=self.object_seeds, BackgroundSeeds=self.background_seeds,
+                           Scalars=self.scalars, **properties)
+
+    def pipeline(self, **properties):
+        """(nodes, mesh, cut) proxies; `properties` maps a filter name to its keyword arguments."""
+        nodes = self.feature_nodes(**properties.get("FeatureNodes", {}))
+        mesh = self.mesh(nodes, **properties.get("DelaunayImageMesh", {}))
+        return nodes, mesh, self.super_voxel_cut(mesh, **properties.get("SuperVoxelCut", {}))

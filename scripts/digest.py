@@ -1,0 +1,69 @@
+"""Digests of every stage's output on every case (pvpython): the check behind "same results".
+
+usage: pvpython scripts/digest.py [--cases a,b] [--out FILE]
+For each case (bundled Data/ and ../shared/data/cases) prints one line per output: the SHA-256 of
+the node points and arrays, of the mesh (points, cells, every cell array by value), of the
+super-voxel labels (cells and label image) and of the voxel cut's labels, at the default
+properties; 3D cases also with the CGAL backend. Compare two runs with diff.
+"""
+import argparse
+import hashlib
+import os
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+import featuremesh as fm  # noqa: E402
+
+# Cell arrays by value, in a fixed order; the quality array was once called Quality.
+CELL_ARRAYS = ("PixelCount", "MeanIntensity", "IntensityStdDev", "Interpolated", ("MinAngle", "MinDihedralAngle", "Quality"),
+               "RadiusRatio")
+
+
+def sha(*arrays):
+    h = hashlib.sha256()
+    for a in arrays:
+        h.update(fm.np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()[:16]
+
+
+def cell_array(data, names):
+    for n in (names if isinstance(names, tuple) else (names,)):
+        a = data.GetCellData().GetArray(n)
+        if a is not None:
+            return fm.v2n(a)
+    raise KeyError(names)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--cases", default="")
+    ap.add_argument("--out")
+    args = ap.parse_args()
+    fm.load_plugin()
+    lines = []
+    for name, d in fm.cases([c for c in args.cases.split(",") if c]).items():
+        case = fm.Case(d)
+        nodes = case.feature_nodes()
+        n = fm.fetch(nodes)
+        lines.append("%s nodes %s" % (name, sha(fm.v2n(n.GetPoints().GetData()),
+                                               *[fm.v2n(n.GetPointData().GetArray(a)) for a in ("NodeType", "Fixed", "SampleRadius")])))
+        for backend in ([0, 1] if case.is3d else [0]):
+            mesh = case.mesh(nodes, Backend=backend)
+            m = fm.fetch(mesh)
+            tag = "%s/%s" % (name, "CGAL" if backend else "default")
+            lines.append("%s mesh %s" % (tag, sha(fm.v2n(m.GetPoints().GetData()), fm.v2n(m.GetCells().GetConnectivityArray()),
+                                                  *[cell_array(m, a) for a in CELL_ARRAYS])))
+            cut = case.super_voxel_cut(mesh)
+            lines.append("%s labels %s" % (tag, sha(fm.v2n(fm.fetch(cut, 0).GetCellData().GetArray("Label")),
+                                                    fm.v2n(fm.fetch(cut, 2).GetPointData().GetScalars()))))
+        lines.append("%s voxelcut %s" % (name, sha(fm.v2n(fm.fetch(case.voxel_cut()).GetPointData().GetScalars()))))
+        print(lines[-1], flush=True)
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if args.out:
+        with open(args.out, "w") as f:
+            f.write(text)
+
+
+if __name__ == "__main__":
+    main()
