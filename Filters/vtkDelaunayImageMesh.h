@@ -9,8 +9,9 @@
  * Delaunay_triangulation_3). Missing image corners are added (NodeType 4), so the mesh tiles the
  * image box. Every voxel centre belongs to exactly one element (see ElementRasterizer.h for the
  * tie rule); cell arrays: PixelCount, MeanIntensity, IntensityStdDev, Interpolated (1 = element
- * owns no centre, mean interpolated at its centroid), Quality (minimum angle / minimum dihedral
- * angle, degrees), RadiusRatio (1 = equilateral).
+ * owns no centre, mean interpolated at its centroid), MinAngle (triangles) or MinDihedralAngle
+ * (tetrahedra) in degrees, RadiusRatio (1 = equilateral). Field data record the image frame
+ * (origin, spacing, dimensions, direction) so that later stages can work without the image.
  */
 #ifndef vtkDelaunayImageMesh_h
 #define vtkDelaunayImageMesh_h
@@ -54,10 +55,11 @@ protected:
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  int Backend = TETGEN;
-  bool QualityRefinement = false;
-  double RadiusEdgeRatio = 2.0;
-  double MinDihedralAngle = 10.0;
+  // Defaults: featuremesh::DelaunayOptions.
+  int Backend;
+  bool QualityRefinement;
+  double RadiusEdgeRatio;
+  double MinDihedralAngle;
 
 private:
   vtkDelaunayImageMesh(const vtkDelaunayImageMesh&) = delete;

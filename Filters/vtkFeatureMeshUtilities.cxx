@@ -1,6 +1,16 @@
 #include "vtkFeatureMeshUtilities.h"
 
+#include "Contract.h"
+
 #include "vtkAlgorithm.h"
+#include "vtkCellArray.h"
+#include "vtkCellData.h"
+#include "vtkIdTypeArray.h"
+#include "vtkMatrix3x3.h"
+#include "vtkPointSet.h"
+#include "vtkPoints.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkUnstructuredGrid.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
@@ -22,14 +32,6 @@
 
 namespace featuremesh
 {
-void EnsureThreadedBackend()
-{
-  if (!std::getenv("VTK_SMP_BACKEND_IN_USE") && std::string(vtkSMPTools::GetBackend()) == "Sequential")
-  {
-    vtkSMPTools::SetBackend("STDThread");
-  }
-}
-
 ParallelFor SMPParallelFor()
 {
   return [](std::int64_t n, std::int64_t grain, const RangeFunction& f) {
@@ -55,7 +57,7 @@ ProgressFunction AlgorithmProgress(vtkAlgorithm* algorithm, double begin, double
   };
 }
 
-bool ImageGrid(vtkImageData* image, Grid& grid, std::string& error)
+bool ImageGeometryOf(vtkImageData* image, ImageGeometry& geometry, std::string& error)
 {
   if (!image || image->GetNumberOfPoints() == 0)
   {
@@ -71,8 +73,222 @@ bool ImageGrid(vtkImageData* image, Grid& grid, std::string& error)
       " voxels; FeatureMesh needs at least 2 voxels along x and y (2D images lie in the xy plane).";
     return false;
   }
-  grid.Dims = { { dims[0], dims[1], dims[2] } };
+  ImageGeometry g;
+  g.Dims = { { dims[0], dims[1], dims[2] } };
+  std::copy(image->GetSpacing(), image->GetSpacing() + 3, g.Spacing.begin());
+  const double* d = image->GetDirectionMatrix()->GetData();
+  std::copy(d, d + 9, g.Direction.begin());
+  const int* ext = image->GetExtent();
+  image->TransformContinuousIndexToPhysicalPoint(ext[0], ext[2], ext[4], g.Origin.data());
+  error = g.Validate();
+  if (!error.empty())
+  {
+    return false;
+  }
+  geometry = g;
   return true;
+}
+
+void AddImageGeometry(const ImageGeometry& g, vtkDataObject* object)
+{
+  auto add = [&](const char* name, const double* v, int n) {
+    vtkNew<vtkDoubleArray> a;
+    a->SetName(name);
+    a->SetNumberOfComponents(n);
+    a->InsertNextTuple(v);
+    object->GetFieldData()->AddArray(a);
+  };
+  const double dims[3] = { double(g.Dims[0]), double(g.Dims[1]), double(g.Dims[2]) };
+  add(names::ImageOrigin, g.Origin.data(), 3);
+  add(names::ImageSpacing, g.Spacing.data(), 3);
+  add(names::ImageDimensions, dims, 3);
+  add(names::ImageDirection, g.Direction.data(), 9);
+}
+
+bool ImageGeometryFromFieldData(vtkDataObject* object, ImageGeometry& geometry, std::string& error)
+{
+  vtkFieldData* fd = object->GetFieldData();
+  vtkDataArray* o = fd->GetArray(names::ImageOrigin);
+  vtkDataArray* s = fd->GetArray(names::ImageSpacing);
+  vtkDataArray* d = fd->GetArray(names::ImageDimensions);
+  vtkDataArray* r = fd->GetArray(names::ImageDirection);
+  if (!o || !s || !d || o->GetNumberOfComponents() != 3 || s->GetNumberOfComponents() != 3 ||
+    d->GetNumberOfComponents() != 3 || o->GetNumberOfTuples() < 1 || s->GetNumberOfTuples() < 1 ||
+    d->GetNumberOfTuples() < 1)
+  {
+    error = "connect the Image input, or give a mesh made by Delaunay Image Mesh (its field data hold the image grid).";
+    return false;
+  }
+  ImageGeometry g;
+  for (int a = 0; a < 3; ++a)
+  {
+    g.Origin[a] = o->GetComponent(0, a);
+    g.Spacing[a] = s->GetComponent(0, a);
+    const double n = d->GetComponent(0, a);
+    g.Dims[a] = n >= 1 && n <= 1e9 ? static_cast<int>(n) : 0;
+  }
+  // Meshes written before the direction was recorded have an identity frame.
+  if (r && r->GetNumberOfComponents() == 9 && r->GetNumberOfTuples() >= 1)
+  {
+    for (int k = 0; k < 9; ++k)
+    {
+      g.Direction[k] = r->GetComponent(0, k);
+    }
+  }
+  error = g.Validate();
+  if (!error.empty())
+  {
+    error = "the mesh's image frame (field data): " + error;
+    return false;
+  }
+  geometry = g;
+  return true;
+}
+
+void SetImageFrame(vtkImageData* image, const ImageGeometry& g)
+{
+  image->SetExtent(0, g.Dims[0] - 1, 0, g.Dims[1] - 1, 0, g.Dims[2] - 1);
+  image->SetOrigin(g.Origin.data());
+  image->SetSpacing(g.Spacing.data());
+  image->SetDirectionMatrix(g.Direction.data());
+}
+
+std::vector<std::array<double, 3>> PointsOf(vtkPointSet* points)
+{
+  const vtkIdType n = points ? points->GetNumberOfPoints() : 0;
+  std::vector<std::array<double, 3>> p(n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    points->GetPoint(i, p[i].data());
+  }
+  return p;
+}
+
+bool ToSimplexMesh(vtkUnstructuredGrid* grid, const ImageGeometry& geometry, SimplexMesh& mesh, std::string& error)
+{
+  const vtkIdType nCells = grid ? grid->GetNumberOfCells() : 0;
+  if (nCells == 0)
+  {
+    error = "the mesh is empty.";
+    return false;
+  }
+  const int cellType = grid->GetCellType(0);
+  if (cellType != VTK_TRIANGLE && cellType != VTK_TETRA)
+  {
+    error = "the mesh must consist of triangles (2D) or tetrahedra (3D).";
+    return false;
+  }
+  const int vpc = cellType == VTK_TRIANGLE ? 3 : 4;
+  std::vector<std::int64_t> cells(static_cast<size_t>(nCells) * vpc);
+  vtkIdType npts;
+  const vtkIdType* ids;
+  for (vtkIdType c = 0; c < nCells; ++c)
+  {
+    grid->GetCellPoints(c, npts, ids);
+    if (grid->GetCellType(c) != cellType || npts != vpc)
+    {
+      error = "the mesh mixes cell types; it must be all triangles or all tetrahedra.";
+      return false;
+    }
+    std::copy(ids, ids + vpc, cells.begin() + c * vpc);
+  }
+  const vtkIdType nPts = grid->GetNumberOfPoints();
+  std::vector<std::array<double, 3>> index(nPts);
+  for (vtkIdType i = 0; i < nPts; ++i)
+  {
+    std::array<double, 3> world;
+    grid->GetPoint(i, world.data());
+    index[i] = geometry.WorldToIndex(world);
+    if (geometry.Is2D())
+    {
+      index[i][2] = 0.0;
+    }
+  }
+  SimplexMesh result(geometry, std::move(index), std::move(cells), vpc);
+  error = result.Validate();
+  if (!error.empty())
+  {
+    return false;
+  }
+  // Positive orientation in index space, whatever the writer's convention or the frame's mirror.
+  std::vector<std::int64_t> oriented = result.Cells();
+  bool flipped = false;
+  for (vtkIdType c = 0; c < nCells; ++c)
+  {
+    std::int64_t* cell = oriented.data() + c * vpc;
+    if (ElementMeasure(result.Points(), cell, vpc) < 0)
+    {
+      std::swap(cell[vpc - 2], cell[vpc - 1]);
+      flipped = true;
+    }
+  }
+  mesh = flipped ? SimplexMesh(geometry, result.Points(), std::move(oriented), vpc) : std::move(result);
+  return true;
+}
+
+void WriteImageMesh(const SimplexMesh& mesh, const ElementStatistics& stats, const std::vector<double>& minAngle,
+  const std::vector<double>& radiusRatio, vtkUnstructuredGrid* output)
+{
+  const int vpc = mesh.VerticesPerCell();
+  const bool is2D = vpc == 3;
+  const vtkIdType nPts = mesh.NumberOfPoints();
+  const vtkIdType nCells = mesh.NumberOfElements();
+  const std::vector<std::array<double, 3>> world = mesh.WorldPoints();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(nPts);
+  for (vtkIdType i = 0; i < nPts; ++i)
+  {
+    points->SetPoint(i, world[i].data());
+  }
+  output->SetPoints(points);
+  vtkNew<vtkIdTypeArray> connectivity, offsets;
+  connectivity->SetNumberOfTuples(static_cast<vtkIdType>(mesh.Cells().size()));
+  vtkIdType* conn = connectivity->GetPointer(0);
+  std::copy(mesh.Cells().begin(), mesh.Cells().end(), conn);
+  if (mesh.Geometry().IsMirrored())
+  {
+    for (vtkIdType c = 0; c < nCells; ++c)
+    {
+      std::swap(conn[c * vpc + vpc - 2], conn[c * vpc + vpc - 1]);
+    }
+  }
+  offsets->SetNumberOfTuples(nCells + 1);
+  for (vtkIdType c = 0; c <= nCells; ++c)
+  {
+    offsets->SetValue(c, c * vpc);
+  }
+  vtkNew<vtkCellArray> cells;
+  cells->SetData(offsets, connectivity);
+  output->SetCells(is2D ? VTK_TRIANGLE : VTK_TETRA, cells);
+
+  auto addCellArray = [&](const char* name, auto* arr, const auto& data) {
+    arr->SetName(name);
+    arr->SetNumberOfTuples(nCells);
+    for (vtkIdType c = 0; c < nCells; ++c)
+    {
+      arr->SetValue(c, data[c]);
+    }
+    output->GetCellData()->AddArray(arr);
+  };
+  vtkNew<vtkIdTypeArray> pixelCount;
+  vtkNew<vtkDoubleArray> mean, stddev, angle, ratio;
+  vtkNew<vtkUnsignedCharArray> interpolated;
+  addCellArray(names::PixelCount, pixelCount.GetPointer(), stats.PixelCount);
+  addCellArray(names::MeanIntensity, mean.GetPointer(), stats.Mean);
+  addCellArray(names::IntensityStdDev, stddev.GetPointer(), stats.StdDev);
+  addCellArray(names::Interpolated, interpolated.GetPointer(), stats.Interpolated);
+  addCellArray(is2D ? names::MinAngle : names::MinDihedralAngle, angle.GetPointer(), minAngle);
+  addCellArray(names::RadiusRatio, ratio.GetPointer(), radiusRatio);
+  output->GetCellData()->SetActiveScalars(names::MeanIntensity);
+
+  // Field data: a summary a user (or a report) can read without recomputing, and the frame.
+  AddFieldValue(output, names::NumberOfNodes, static_cast<double>(nPts));
+  AddFieldValue(output, names::NumberOfElements, static_cast<double>(nCells));
+  const auto mm = std::minmax_element(minAngle.begin(), minAngle.end());
+  AddFieldValue(output, is2D ? names::MinAngle : names::MinDihedralAngle, nCells ? *mm.first : 0.0);
+  AddFieldValue(output, is2D ? names::MaxOfMinAngles : names::MaxOfMinDihedralAngles, nCells ? *mm.second : 0.0);
+  AddImageGeometry(mesh.Geometry(), output);
 }
 
 void RequestWholeImage(vtkInformationVector* portVector)
@@ -230,20 +446,4 @@ void AddFieldValue(vtkDataObject* object, const char* name, double value)
   object->GetFieldData()->AddArray(a);
 }
 
-void WorldToIndex(vtkImageData* image, const double world[3], double index[3])
-{
-  image->TransformPhysicalPointToContinuousIndex(world, index);
-  const int* ext = image->GetExtent();
-  for (int a = 0; a < 3; ++a)
-  {
-    index[a] -= ext[2 * a];
-  }
-}
-
-void IndexToWorld(vtkImageData* image, const double index[3], double world[3])
-{
-  const int* ext = image->GetExtent();
-  image->TransformContinuousIndexToPhysicalPoint(
-    index[0] + ext[0], index[1] + ext[2], index[2] + ext[4], world);
-}
 } // namespace featuremesh

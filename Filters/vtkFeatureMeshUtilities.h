@@ -1,11 +1,17 @@
 // VTK plumbing shared by the FeatureMesh filters: thread backend, parallel-for and progress
-// adapters for the VTK-free core, and the image checks every stage makes the same way.
+// adapters for the VTK-free core, the image checks every stage makes the same way, and the
+// adapters between VTK data and the core's ImageGeometry and SimplexMesh.
 #ifndef vtkFeatureMeshUtilities_h
 #define vtkFeatureMeshUtilities_h
 
-#include "Grid.h"
+#include "ElementRasterizer.h"
+#include "ImageGeometry.h"
 #include "Parallel.h"
+#include "SimplexMesh.h"
 
+#include "vtkSMPTools.h"
+
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -16,12 +22,23 @@ class vtkImageData;
 class vtkInformation;
 class vtkInformationVector;
 class vtkPointSet;
+class vtkUnstructuredGrid;
 
 namespace featuremesh
 {
-// Selects the STDThread SMP backend when VTK runs the Sequential default and the user did not
-// choose one with VTK_SMP_BACKEND_IN_USE.
-void EnsureThreadedBackend();
+// Runs `body` (returning int) on the STDThread SMP backend when VTK runs its Sequential default
+// and the user chose none with VTK_SMP_BACKEND_IN_USE; the host's backend is left as it was.
+template <typename Body>
+int WithThreads(Body&& body)
+{
+  if (std::getenv("VTK_SMP_BACKEND_IN_USE") || std::string(vtkSMPTools::GetBackend()) != "Sequential")
+  {
+    return body();
+  }
+  int result = 0;
+  vtkSMPTools::LocalScope(vtkSMPTools::Config(std::string("STDThread")), [&]() { result = body(); });
+  return result;
+}
 
 // A parallel-for on vtkSMPTools.
 ParallelFor SMPParallelFor();
@@ -29,9 +46,30 @@ ParallelFor SMPParallelFor();
 // Maps core progress [0,1] to [begin,end] of the algorithm's progress; false once abort is asked.
 ProgressFunction AlgorithmProgress(vtkAlgorithm* algorithm, double begin, double end);
 
-// Grid of an image, or an error sentence: the image must have at least 2 voxels along x and y,
-// and be a single xy slice (2D) or a volume with at least 2 voxels along z (3D).
-bool ImageGrid(vtkImageData* image, Grid& grid, std::string& error);
+// The frame of an image (its extent's first voxel is index 0), or an error sentence: the image
+// must have at least 2 voxels along x and y, and a usable spacing and direction.
+bool ImageGeometryOf(vtkImageData* image, ImageGeometry& geometry, std::string& error);
+
+// The image frame in field data (ImageOrigin, ImageSpacing, ImageDimensions, ImageDirection), so
+// that later stages can rasterise onto the grid without the image.
+void AddImageGeometry(const ImageGeometry& geometry, vtkDataObject* object);
+bool ImageGeometryFromFieldData(vtkDataObject* object, ImageGeometry& geometry, std::string& error);
+
+// Gives `image` the frame's extent (from 0), origin, spacing and direction.
+void SetImageFrame(vtkImageData* image, const ImageGeometry& geometry);
+
+// The points of a point set, world coordinates (empty for null).
+std::vector<std::array<double, 3>> PointsOf(vtkPointSet* points);
+
+// A triangle (2D) / tetrahedral (3D) unstructured grid as a SimplexMesh on `geometry`'s index
+// space, every element positively oriented there; false with a sentence for mixed or other cell
+// types, or a cell type that does not match the image's dimension.
+bool ToSimplexMesh(vtkUnstructuredGrid* grid, const ImageGeometry& geometry, SimplexMesh& mesh, std::string& error);
+
+// The image-mesh output of stages 2 and 3: world points, cells (positively oriented in world
+// coordinates), the statistics and quality cell arrays, the image frame and summary field data.
+void WriteImageMesh(const SimplexMesh& mesh, const ElementStatistics& statistics, const std::vector<double>& minAngle,
+  const std::vector<double>& radiusRatio, vtkUnstructuredGrid* output);
 
 // Sets the update extent of every image connected to `port` to its whole extent.
 void RequestWholeImage(vtkInformationVector* portVector);
@@ -55,10 +93,6 @@ vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::s
 
 // Adds a one-value double array `name` to the object's field data (summaries, timings).
 void AddFieldValue(vtkDataObject* object, const char* name, double value);
-
-// Index-space coordinates (relative to the extent's start) of a world point.
-void WorldToIndex(vtkImageData* image, const double world[3], double index[3]);
-void IndexToWorld(vtkImageData* image, const double index[3], double world[3]);
 } // namespace featuremesh
 
 #endif

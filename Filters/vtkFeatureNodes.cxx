@@ -1,5 +1,6 @@
 #include "vtkFeatureNodes.h"
 
+#include "Contract.h"
 #include "FeatureNodes.h"
 #include "vtkFeatureMeshUtilities.h"
 
@@ -26,6 +27,19 @@ vtkStandardNewMacro(vtkFeatureNodes);
 
 vtkFeatureNodes::vtkFeatureNodes()
 {
+  const featuremesh::FeatureNodeParameters defaults;
+  this->GaussianSigma = defaults.GaussianSigma;
+  this->HessianSigma = defaults.HessianSigma;
+  this->LowThreshold = defaults.LowThreshold;
+  this->HighThreshold = defaults.HighThreshold;
+  this->MaximumPercentile = defaults.MaximumPercentile;
+  this->CovarianceNeighbourhood = defaults.CovarianceNeighbourhood;
+  this->Halftoning = defaults.Halftoning;
+  this->HalftoneThreshold = defaults.HalftoneThreshold;
+  this->HalftoneGamma = defaults.HalftoneGamma;
+  this->ExclusionWindow = defaults.ExclusionWindow;
+  this->UniformSpacing = defaults.UniformSpacing;
+  this->BoundarySpacing = defaults.BoundarySpacing;
   this->SetNumberOfInputPorts(2);
   this->SetNumberOfOutputPorts(2);
   this->SetInputArrayToProcess(
@@ -51,16 +65,12 @@ int vtkFeatureNodes::FillOutputPortInformation(int port, vtkInformation* info)
 int vtkFeatureNodes::RequestInformation(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  // The edge map's extent starts at 0; its frame comes with the data.
   vtkInformation* edgeInfo = outputVector->GetInformationObject(1);
   int ext[6];
-  double spacing[3], origin[3];
-  inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), ext);
-  inInfo->Get(vtkDataObject::SPACING(), spacing);
-  inInfo->Get(vtkDataObject::ORIGIN(), origin);
-  edgeInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), ext, 6);
-  edgeInfo->Set(vtkDataObject::SPACING(), spacing, 3);
-  edgeInfo->Set(vtkDataObject::ORIGIN(), origin, 3);
+  inputVector[0]->GetInformationObject(0)->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), ext);
+  const int whole[6] = { 0, ext[1] - ext[0], 0, ext[3] - ext[2], 0, ext[5] - ext[4] };
+  edgeInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole, 6);
   vtkDataObject::SetPointDataActiveScalarInfo(edgeInfo, VTK_UNSIGNED_CHAR, 1);
   return 1;
 }
@@ -77,18 +87,22 @@ int vtkFeatureNodes::RequestUpdateExtent(
 int vtkFeatureNodes::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  return featuremesh::WithThreads([&]() { return this->Execute(inputVector, outputVector); });
+}
+
+int vtkFeatureNodes::Execute(vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
   using namespace featuremesh;
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  EnsureThreadedBackend();
   vtkImageData* input = vtkImageData::GetData(inputVector[0], 0);
   vtkImageData* edgeInput = vtkImageData::GetData(inputVector[1], 0);
   vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
   vtkImageData* edgeOutput = vtkImageData::GetData(outputVector, 1);
 
   std::string error;
-  Grid grid;
-  if (!ImageGrid(input, grid, error))
+  ImageGeometry grid;
+  if (!ImageGeometryOf(input, grid, error))
   {
     vtkErrorMacro("Feature Nodes: " << error);
     return 0;
@@ -137,7 +151,8 @@ int vtkFeatureNodes::RequestData(
     }
     int dims[3];
     edgeInput->GetDimensions(dims);
-    if (!edgeArray || dims[0] != grid.Dims[0] || dims[1] != grid.Dims[1] || dims[2] != grid.Dims[2])
+    if (!edgeArray || dims[0] != grid.Dims[0] || dims[1] != grid.Dims[1] || dims[2] != grid.Dims[2] ||
+      edgeArray->GetNumberOfTuples() != grid.Size())
     {
       vtkErrorMacro("Feature Nodes: the edge map must be an image with a point array on the same grid as the input ("
         << grid.Dims[0] << "x" << grid.Dims[1] << "x" << grid.Dims[2] << ").");
@@ -172,9 +187,9 @@ int vtkFeatureNodes::RequestData(
   points->SetNumberOfPoints(n);
   vtkNew<vtkUnsignedCharArray> type, fixed;
   vtkNew<vtkFloatArray> radius;
-  type->SetName("NodeType");
-  fixed->SetName("Fixed");
-  radius->SetName("SampleRadius");
+  type->SetName(names::NodeType);
+  fixed->SetName(names::Fixed);
+  radius->SetName(names::SampleRadius);
   type->SetNumberOfTuples(n);
   fixed->SetNumberOfTuples(n);
   radius->SetNumberOfTuples(n);
@@ -183,11 +198,8 @@ int vtkFeatureNodes::RequestData(
   for (vtkIdType i = 0; i < n; ++i)
   {
     const auto& ijk = result.Positions[i];
-    const double index[3] = { double(ijk[0]), double(ijk[1]), double(ijk[2]) };
-    double world[3];
-    IndexToWorld(input, index, world);
-    points->SetPoint(i, world);
-    type->SetValue(i, result.Type[i]);
+    points->SetPoint(i, grid.IndexToWorld({ { double(ijk[0]), double(ijk[1]), double(ijk[2]) } }).data());
+    type->SetValue(i, static_cast<unsigned char>(result.Type[i]));
     fixed->SetValue(i, result.Fixed[i]);
     radius->SetValue(i, result.SampleRadius[i]);
     verts->InsertNextCell(1, &i);
@@ -197,10 +209,10 @@ int vtkFeatureNodes::RequestData(
   output->GetPointData()->AddArray(type);
   output->GetPointData()->AddArray(fixed);
   output->GetPointData()->AddArray(radius);
-  output->GetPointData()->SetActiveScalars("NodeType");
+  output->GetPointData()->SetActiveScalars(names::NodeType);
 
   vtkNew<vtkIntArray> counts;
-  counts->SetName("NodeCounts");
+  counts->SetName(names::NodeCounts);
   counts->SetNumberOfComponents(4);
   counts->SetComponentName(0, "Canny");
   counts->SetComponentName(1, "Halftone");
@@ -209,7 +221,7 @@ int vtkFeatureNodes::RequestData(
   counts->InsertNextTuple4(result.Counts[0], result.Counts[1], result.Counts[2], result.Counts[3]);
   output->GetFieldData()->AddArray(counts);
   vtkNew<vtkDoubleArray> timing;
-  timing->SetName("StepSeconds");
+  timing->SetName(names::StepSeconds);
   timing->SetNumberOfComponents(static_cast<int>(result.StepSeconds.size()) + 1);
   timing->SetComponentName(0, "prepare");
   std::vector<double> tuple = { prepSeconds };
@@ -222,12 +234,9 @@ int vtkFeatureNodes::RequestData(
   output->GetFieldData()->AddArray(timing);
 
   // Output 1: the edge map used.
-  edgeOutput->SetExtent(input->GetExtent());
-  edgeOutput->SetSpacing(input->GetSpacing());
-  edgeOutput->SetOrigin(input->GetOrigin());
-  edgeOutput->SetDirectionMatrix(input->GetDirectionMatrix());
+  SetImageFrame(edgeOutput, grid);
   vtkNew<vtkUnsignedCharArray> edgeArray;
-  edgeArray->SetName("EdgeMap");
+  edgeArray->SetName(names::EdgeMap);
   edgeArray->SetNumberOfTuples(static_cast<vtkIdType>(result.EdgeMap.size()));
   std::copy(result.EdgeMap.begin(), result.EdgeMap.end(), edgeArray->GetPointer(0));
   edgeOutput->GetPointData()->SetScalars(edgeArray);

@@ -85,19 +85,21 @@ protected:
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int Execute(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
 
-  double GaussianSigma = 0.7;
-  double HessianSigma = 2.0;
-  double LowThreshold = 0.1;
-  double HighThreshold = 0.6;
-  double MaximumPercentile = 99.0;
-  int CovarianceNeighbourhood = 0;
-  bool Halftoning = true;
-  double HalftoneThreshold = 0.3;
-  double HalftoneGamma = 1.0;
-  int ExclusionWindow = 7;
-  int UniformSpacing = 7;
-  int BoundarySpacing = 7;
+  // Defaults: featuremesh::FeatureNodeParameters.
+  double GaussianSigma;
+  double HessianSigma;
+  double LowThreshold;
+  double HighThreshold;
+  double MaximumPercentile;
+  int CovarianceNeighbourhood;
+  bool Halftoning;
+  double HalftoneThreshold;
+  double HalftoneGamma;
+  int ExclusionWindow;
+  int UniformSpacing;
+  int BoundarySpacing;
 
 private:
   vtkFeatureNodes(const vtkFeatureNodes&) = delete;

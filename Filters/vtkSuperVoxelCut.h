@@ -54,11 +54,12 @@ protected:
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  int Bins = 0;
-  double Sigma = 0.0;
-  double Lambda = 1.0;
-  bool ScaleByContact = true;
-  bool VoxelRegionTerm = true;
+  // Defaults: featuremesh::SuperVoxelCutParameters.
+  int Bins;
+  double Sigma;
+  double Lambda;
+  bool ScaleByContact;
+  bool VoxelRegionTerm;
 
 private:
   vtkSuperVoxelCut(const vtkSuperVoxelCut&) = delete;

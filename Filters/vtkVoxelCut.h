@@ -46,10 +46,11 @@ protected:
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  int Bins = 0;
-  double Sigma = 0.0;
-  double Lambda = 1.0;
-  double SeedRadius = 2.0;
+  // Defaults: featuremesh::VoxelCutParameters.
+  int Bins;
+  double Sigma;
+  double Lambda;
+  double SeedRadius;
 
 private:
   vtkVoxelCut(const vtkVoxelCut&) = delete;

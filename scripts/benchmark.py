@@ -82,7 +82,7 @@ def main():
         V = v2n(sm.Fetch(vc).GetPointData().GetScalars())
         med = {k: statistics.median(v) for k, v in times.items()}
         total = sum(med.values())
-        q = v2n(labelled.GetCellData().GetArray("Quality"))
+        q = v2n(labelled.GetCellData().GetArray("MinAngle") or labelled.GetCellData().GetArray("MinDihedralAngle"))
         row = {"case": name, "voxels": T.size, "nodes": labelled.GetNumberOfPoints(), "elements": labelled.GetNumberOfCells(),
                "nodes_s": med["nodes"], "mesh_s": med["mesh"], "cut_s": med["cut"], "total_s": total,
                "voxel_cut_s": statistics.median(vt), "speedup": statistics.median(vt) / total,

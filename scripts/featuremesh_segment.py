@@ -74,7 +74,7 @@ def main():
         writer.Write()
     fd = labelled.GetFieldData()
     field = {fd.GetArrayName(i): fd.GetArray(i).GetValue(0) for i in range(fd.GetNumberOfArrays()) if fd.GetArray(i) is not None}
-    quality = v2n(labelled.GetCellData().GetArray("Quality"))
+    quality = v2n(labelled.GetCellData().GetArray("MinAngle") or labelled.GetCellData().GetArray("MinDihedralAngle"))
     report = {"image": os.path.abspath(args.image), "seconds": times, "total_seconds": sum(v for k, v in times.items() if k != "read"),
               "nodes": labelled.GetNumberOfPoints(), "elements": labelled.GetNumberOfCells(),
               "min_quality_degrees": float(quality.min()), "median_quality_degrees": float(sorted(quality)[len(quality) // 2]),

@@ -5,20 +5,16 @@
 
 namespace featuremesh
 {
-ElementRasterizer::ElementRasterizer(const std::vector<std::array<double, 3>>& indexPoints,
-  const std::vector<std::int64_t>& cells, int verticesPerCell, const Grid& grid)
-  : Points(&indexPoints)
-  , Cells(&cells)
-  , Vpc(verticesPerCell)
-  , G(grid)
+ElementRasterizer::ElementRasterizer(const SimplexMesh& mesh)
+  : M(&mesh)
 {
   for (int a = 0; a < 3; ++a)
   {
-    this->TwiceCentre[a] = grid.Dims[a] - 1.0;
+    this->TwiceCentre[a] = mesh.Geometry().Dims[a] - 1.0;
   }
 }
 
-double InterpolateAt(const double* values, const Grid& g, const double index[3])
+double InterpolateAt(const double* values, const ImageGeometry& g, const double index[3])
 {
   int base[3];
   double t[3];
@@ -51,10 +47,12 @@ double InterpolateAt(const double* values, const Grid& g, const double index[3])
   return result;
 }
 
-ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster,
-  const std::vector<std::array<double, 3>>& P, const std::vector<std::int64_t>& cells, int vpc,
-  const double* values, const Grid& g, const ParallelFor& parallel)
+ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, const double* values,
+  const ParallelFor& parallel)
 {
+  const SimplexMesh& mesh = raster.Mesh();
+  const auto& P = mesh.Points();
+  const int vpc = mesh.VerticesPerCell();
   const std::int64_t m = raster.NumberOfElements();
   ElementStatistics s;
   s.PixelCount.assign(m, 0);
@@ -85,10 +83,10 @@ ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster,
         {
           for (int a = 0; a < 3; ++a)
           {
-            centroid[a] += P[cells[c * vpc + v]][a] / vpc;
+            centroid[a] += P[mesh.Cell(c)[v]][a] / vpc;
           }
         }
-        s.Mean[c] = InterpolateAt(values, g, centroid);
+        s.Mean[c] = InterpolateAt(values, mesh.Geometry(), centroid);
         s.Interpolated[c] = 1;
         continue;
       }
@@ -103,9 +101,9 @@ ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster,
   return s;
 }
 
-std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const Grid& g, const ParallelFor& parallel)
+std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const ParallelFor& parallel)
 {
-  std::vector<std::int64_t> owner(g.Size(), -1);
+  std::vector<std::int64_t> owner(raster.Mesh().Geometry().Size(), -1);
   // Each centre has exactly one owner, so the writes never collide.
   parallel(raster.NumberOfElements(), 512, [&](std::int64_t b, std::int64_t e) {
     for (std::int64_t c = b; c < e; ++c)
@@ -114,24 +112,6 @@ std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const Gri
     }
   });
   return owner;
-}
-
-double ElementMeasure(const std::vector<std::array<double, 3>>& P, const std::int64_t* c, int vpc)
-{
-  const auto& a = P[c[0]];
-  const auto& b = P[c[1]];
-  const auto& d = P[c[2]];
-  if (vpc == 3)
-  {
-    return 0.5 * ((b[0] - a[0]) * (d[1] - a[1]) - (b[1] - a[1]) * (d[0] - a[0]));
-  }
-  const auto& e = P[c[3]];
-  const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
-  const double v[3] = { d[0] - a[0], d[1] - a[1], d[2] - a[2] };
-  const double w[3] = { e[0] - a[0], e[1] - a[1], e[2] - a[2] };
-  return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-           u[2] * (v[0] * w[1] - v[1] * w[0])) /
-    6.0;
 }
 
 namespace
@@ -156,16 +136,18 @@ double Norm(const V3& a)
 constexpr double Degrees = 180.0 / 3.14159265358979323846;
 } // namespace
 
-void ElementQuality(const std::vector<std::array<double, 3>>& P, const std::vector<std::int64_t>& cells, int vpc,
-  std::vector<double>& minAngle, std::vector<double>& radiusRatio, const ParallelFor& parallel)
+void ElementQuality(const SimplexMesh& mesh, std::vector<double>& minAngle, std::vector<double>& radiusRatio,
+  const ParallelFor& parallel)
 {
-  const std::int64_t m = static_cast<std::int64_t>(cells.size()) / vpc;
+  const std::vector<std::array<double, 3>> P = mesh.FramePoints();
+  const int vpc = mesh.VerticesPerCell();
+  const std::int64_t m = mesh.NumberOfElements();
   minAngle.assign(m, 0.0);
   radiusRatio.assign(m, 0.0);
   parallel(m, 4096, [&](std::int64_t b, std::int64_t e) {
     for (std::int64_t c = b; c < e; ++c)
     {
-      const std::int64_t* id = cells.data() + c * vpc;
+      const std::int64_t* id = mesh.Cell(c);
       if (vpc == 3)
       {
         const V3 &a = P[id[0]], &bb = P[id[1]], &d = P[id[2]];

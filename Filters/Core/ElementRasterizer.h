@@ -8,8 +8,8 @@
 // space, so every test is exact in double arithmetic (added, off-lattice nodes are rounded).
 #pragma once
 
-#include "Grid.h"
 #include "Parallel.h"
+#include "SimplexMesh.h"
 
 #include <array>
 #include <cmath>
@@ -21,12 +21,12 @@ namespace featuremesh
 class ElementRasterizer
 {
 public:
-  // `indexPoints` in index space (x, y, z; z = 0 in 2D), `cells` with 3 (triangles, 2D) or 4
-  // (tetrahedra) ids each, positively oriented.
-  ElementRasterizer(const std::vector<std::array<double, 3>>& indexPoints, const std::vector<std::int64_t>& cells,
-    int verticesPerCell, const Grid& grid);
+  // The mesh must outlive the rasteriser; its points are in index space (z = 0 in 2D), its
+  // elements positively oriented.
+  explicit ElementRasterizer(const SimplexMesh& mesh);
 
-  std::int64_t NumberOfElements() const { return static_cast<std::int64_t>(this->Cells->size()) / this->Vpc; }
+  const SimplexMesh& Mesh() const { return *this->M; }
+  std::int64_t NumberOfElements() const { return this->M->NumberOfElements(); }
 
   // Calls visit(voxelIndex) for every voxel centre owned by the element, in raster order.
   template <typename Visitor>
@@ -35,10 +35,7 @@ public:
 private:
   bool Owns(const double* plane, int faces, double x, double y, double z) const;
 
-  const std::vector<std::array<double, 3>>* Points;
-  const std::vector<std::int64_t>* Cells;
-  int Vpc;
-  Grid G;
+  const SimplexMesh* M;
   double TwiceCentre[3];
 };
 
@@ -51,23 +48,20 @@ struct ElementStatistics
   std::vector<double> StdDev;
   std::vector<std::uint8_t> Interpolated;
 };
-ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster,
-  const std::vector<std::array<double, 3>>& indexPoints, const std::vector<std::int64_t>& cells, int verticesPerCell,
-  const double* values, const Grid& grid, const ParallelFor& parallel);
+// `values` has one value per voxel of the mesh's image.
+ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, const double* values,
+  const ParallelFor& parallel);
 
 // Owner element of every voxel (-1 where none, which only happens when the mesh does not tile the box).
-std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const Grid& grid, const ParallelFor& parallel);
+std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const ParallelFor& parallel);
 
-// Quality in world coordinates: minimum angle (triangles) or minimum dihedral angle (tetrahedra) in
-// degrees, and the radius ratio normalised to 1 for the equilateral element (2r/R, 3r/R).
-void ElementQuality(const std::vector<std::array<double, 3>>& worldPoints, const std::vector<std::int64_t>& cells,
-  int verticesPerCell, std::vector<double>& minAngle, std::vector<double>& radiusRatio, const ParallelFor& parallel);
-
-// Signed area (triangles, in the xy plane) or volume (tetrahedra).
-double ElementMeasure(const std::vector<std::array<double, 3>>& points, const std::int64_t* cell, int verticesPerCell);
+// Quality in frame (world) units: minimum angle (triangles) or minimum dihedral angle (tetrahedra)
+// in degrees, and the radius ratio normalised to 1 for the equilateral element (2r/R, 3r/R).
+void ElementQuality(const SimplexMesh& mesh, std::vector<double>& minAngle, std::vector<double>& radiusRatio,
+  const ParallelFor& parallel);
 
 // Trilinear (bilinear in 2D) interpolation of voxel values at a continuous index.
-double InterpolateAt(const double* values, const Grid& grid, const double index[3]);
+double InterpolateAt(const double* values, const ImageGeometry& grid, const double index[3]);
 
 //------------------------------------------------------------------------------------------------
 // Inline: called once per candidate voxel centre.
@@ -107,9 +101,10 @@ inline bool ElementRasterizer::Owns(const double* plane, int faces, double x, do
 template <typename Visitor>
 void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
 {
-  const std::int64_t* cell = this->Cells->data() + e * this->Vpc;
-  const auto& P = *this->Points;
-  const int faces = this->Vpc;
+  const std::int64_t* cell = this->M->Cell(e);
+  const auto& P = this->M->Points();
+  const auto& G = this->M->Geometry();
+  const int faces = this->M->VerticesPerCell();
   // Plane per face: lambda(p) = n.p + d, positive on the side of the opposite vertex.
   double plane[4][4];
   double lo[3] = { 1e300, 1e300, 1e300 }, hi[3] = { -1e300, -1e300, -1e300 };

@@ -51,7 +51,7 @@ inline std::array<int, 3> QuantisedDirection(float gx, float gy, float gz)
   return { { component(gx), component(gy), component(gz) } };
 }
 
-inline void Coordinates(const Grid& g, std::int64_t idx, int& i, int& j, int& k)
+inline void Coordinates(const ImageGeometry& g, std::int64_t idx, int& i, int& j, int& k)
 {
   const std::int64_t slice = g.SliceStride();
   k = static_cast<int>(idx / slice);
@@ -61,7 +61,7 @@ inline void Coordinates(const Grid& g, std::int64_t idx, int& i, int& j, int& k)
 }
 
 // True when some voxel within the centred box of half-width h around (i,j,k) is set in mask.
-bool AnyInBox(const std::vector<std::uint8_t>& mask, const Grid& g, int i, int j, int k, int h)
+bool AnyInBox(const std::vector<std::uint8_t>& mask, const ImageGeometry& g, int i, int j, int k, int h)
 {
   const int k0 = std::max(0, k - h), k1 = std::min(g.Dims[2] - 1, k + h);
   const int j0 = std::max(0, j - h), j1 = std::min(g.Dims[1] - 1, j + h);
@@ -249,7 +249,7 @@ void SmoothAcrossRows(float* o, int nx, const std::vector<float>& w, const float
 }
 } // namespace
 
-void GaussianSmooth(const float* in, float* out, const Grid& g, double sigma, const ParallelFor& parallel)
+void GaussianSmooth(const float* in, float* out, const ImageGeometry& g, double sigma, const ParallelFor& parallel)
 {
   const std::int64_t n = g.Size();
   if (sigma <= 0.0)
@@ -329,7 +329,7 @@ void GaussianSmooth(const float* in, float* out, const Grid& g, double sigma, co
   });
 }
 
-void GradientMagnitude(const float* f, const Grid& g, float* magnitude, const ParallelFor& parallel)
+void GradientMagnitude(const float* f, const ImageGeometry& g, float* magnitude, const ParallelFor& parallel)
 {
   const std::int64_t sx = 1, sy = g.Dims[0], sz = g.SliceStride();
   const std::int64_t rows = static_cast<std::int64_t>(g.Dims[1]) * g.Dims[2];
@@ -436,7 +436,7 @@ double RobustMaximum(const float* v, std::int64_t n, double percentile, const Pa
   return maximum;
 }
 
-std::vector<std::uint8_t> CannyEdges(const float* f, const Grid& g, double low, double high, double percentile,
+std::vector<std::uint8_t> CannyEdges(const float* f, const ImageGeometry& g, double low, double high, double percentile,
   const ParallelFor& parallel, double* gradientMaximum, float* magnitudeBuffer)
 {
   const std::int64_t n = g.Size();
@@ -608,7 +608,7 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const Grid& g, double low, 
 }
 
 std::vector<std::uint8_t> EdgeSampleRadii(const std::vector<std::int64_t>& pts,
-  const std::vector<std::uint8_t>& edgeMap, const Grid& g, const FeatureNodeParameters& p,
+  const std::vector<std::uint8_t>& edgeMap, const ImageGeometry& g, const FeatureNodeParameters& p,
   const ParallelFor& parallel)
 {
   const bool is2D = g.Is2D();
@@ -757,7 +757,7 @@ std::vector<std::uint8_t> EdgeSampleRadii(const std::vector<std::int64_t>& pts,
 }
 
 std::vector<std::int64_t> ThinEdgePoints(
-  const std::vector<std::int64_t>& pts, const std::vector<std::uint8_t>& radii, const Grid& g)
+  const std::vector<std::int64_t>& pts, const std::vector<std::uint8_t>& radii, const ImageGeometry& g)
 {
   // Densely sampled (curved) points first, so that straight runs give way to corners; within a
   // radius, in voxel order. A counting sort: radii are small integers.
@@ -892,7 +892,7 @@ float LargestAbsEigenvalue(float a11, float a22, float a33, float a12, float a13
   return LargestAbsEigenvalueInline(a11, a22, a33, a12, a13, a23);
 }
 
-void HessianFeatureMap(const float* f, const Grid& g, double gamma, double percentile,
+void HessianFeatureMap(const float* f, const ImageGeometry& g, double gamma, double percentile,
   const ParallelFor& parallel, float* rho, double* featureMaximum)
 {
   const std::int64_t n = g.Size();
@@ -965,7 +965,7 @@ void HessianFeatureMap(const float* f, const Grid& g, double gamma, double perce
   });
 }
 
-std::vector<std::int64_t> Halftone(const float* rho, const Grid& g, double q)
+std::vector<std::int64_t> Halftone(const float* rho, const ImageGeometry& g, double q)
 {
   std::vector<std::int64_t> dots;
   const int nx = g.Dims[0], ny = g.Dims[1], nz = g.Dims[2];
@@ -1037,7 +1037,7 @@ std::vector<std::int64_t> Halftone(const float* rho, const Grid& g, double q)
   return dots;
 }
 
-FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* edgeInput, const Grid& g,
+FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* edgeInput, const ImageGeometry& g,
   const FeatureNodeParameters& p, const ParallelFor& parallel, const ProgressFunction& progress)
 {
   FeatureNodeResult out;
@@ -1133,9 +1133,9 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
     occupied[idx] = 1;
     out.Positions.push_back({ { i, j, k } });
     out.Type.push_back(type);
-    out.Fixed.push_back(type == NodeCanny || type == NodeBoundary ? 1 : 0);
+    out.Fixed.push_back(type == NodeType::Canny || type == NodeType::Boundary ? 1 : 0);
     out.SampleRadius.push_back(radius);
-    out.Counts[type]++;
+    out.Counts[static_cast<int>(type)]++;
   };
 
   // 3. Boundary nodes: corners always, evenly spaced along the border (2D) or on the box faces (3D).
@@ -1155,7 +1155,7 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
           const bool onFace = i == 0 || i == lx || j == 0 || j == ly || (!is2D && (k == 0 || k == lz));
           if (onFace)
           {
-            add(i, j, k, NodeBoundary, r);
+            add(i, j, k, NodeType::Boundary, r);
           }
         }
       }
@@ -1165,7 +1165,7 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
   {
     int i, j, k;
     Coordinates(g, edgePoints[t], i, j, k);
-    add(i, j, k, NodeCanny, static_cast<float>(radii[t]));
+    add(i, j, k, NodeType::Canny, static_cast<float>(radii[t]));
   }
   out.StepSeconds.emplace_back("boundary", SecondsSince(t0));
 
@@ -1198,7 +1198,7 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
       Coordinates(g, d, i, j, k);
       if (!AnyInBox(out.EdgeMap, g, i, j, k, h))
       {
-        add(i, j, k, NodeHalftone, static_cast<float>(h));
+        add(i, j, k, NodeType::Halftone, static_cast<float>(h));
       }
     }
     out.StepSeconds.emplace_back("halftone", SecondsSince(t0));
@@ -1223,7 +1223,7 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
         {
           if (!AnyInBox(occupied, g, i, j, k, h))
           {
-            add(i, j, k, NodeUniform, 0.5f * s);
+            add(i, j, k, NodeType::Uniform, 0.5f * s);
           }
         }
       }

@@ -3,7 +3,8 @@
 #include "DelaunayMesh.h"
 #include "ElementRasterizer.h"
 #include "FeatureNodes.h"
-#include "MeshAdjacency.h"
+#include "SimplexMesh.h"
+#include "SuperVoxelCut.h"
 
 #include <gtest/gtest.h>
 
@@ -19,13 +20,13 @@ using namespace featuremesh;
 
 namespace
 {
-Grid Grid2(int nx, int ny)
+ImageGeometry Grid2(int nx, int ny)
 {
-  Grid g;
+  ImageGeometry g;
   g.Dims = { { nx, ny, 1 } };
   return g;
 }
-std::vector<float> Disk(const Grid& g, double cx, double cy, double r)
+std::vector<float> Disk(const ImageGeometry& g, double cx, double cy, double r)
 {
   std::vector<float> f(g.Size());
   for (int j = 0; j < g.Dims[1]; ++j)
@@ -37,7 +38,7 @@ std::vector<float> Disk(const Grid& g, double cx, double cy, double r)
 
 TEST(Canny, DiskGivesRingAtRadius)
 {
-  const Grid g = Grid2(64, 64);
+  const ImageGeometry g = Grid2(64, 64);
   const std::vector<float> raw = Disk(g, 31.5, 31.5, 15.0);
   std::vector<float> f(raw.size());
   GaussianSmooth(raw.data(), f.data(), g, 0.7, SerialFor());
@@ -56,7 +57,7 @@ TEST(Canny, DiskGivesRingAtRadius)
 
 TEST(Canny, ConstantImageHasNoEdges)
 {
-  const Grid g = Grid2(32, 32);
+  const ImageGeometry g = Grid2(32, 32);
   std::vector<float> f(g.Size(), 5.f);
   const auto edges = CannyEdges(f.data(), g, 0.1, 0.6, 99.0, SerialFor());
   for (auto e : edges)
@@ -65,7 +66,7 @@ TEST(Canny, ConstantImageHasNoEdges)
 
 TEST(PCA, TightCornerIsDenseAndStraightLineSparse)
 {
-  const Grid g = Grid2(64, 64);
+  const ImageGeometry g = Grid2(64, 64);
   FeatureNodeParameters p;
   std::vector<std::uint8_t> map(g.Size(), 0);
   // A straight line; a tight hairpin corner (a 3x3 closed contour, the edge of a speck); and a
@@ -90,7 +91,7 @@ TEST(PCA, TightCornerIsDenseAndStraightLineSparse)
 
 TEST(PCA, ThinningKeepsCornerAndSpacesLine)
 {
-  const Grid g = Grid2(64, 64);
+  const ImageGeometry g = Grid2(64, 64);
   std::vector<std::int64_t> pts;
   std::vector<std::uint8_t> radii;
   for (int i = 0; i < 30; ++i)
@@ -111,7 +112,7 @@ TEST(PCA, ThinningMatchesTheGreedyDefinition)
   // Random 3D points, radii up to 4 (the distance-map path) and up to 12 (the bucket-grid path),
   // against the O(n^2) definition: visit by (radius, index); keep a point when no kept point lies
   // within its (2R+1)-box.
-  Grid g;
+  ImageGeometry g;
   g.Dims = { { 40, 30, 20 } };
   std::mt19937 rng(3);
   for (int largest : { 4, 12 })
@@ -156,7 +157,7 @@ TEST(PCA, ThinningMatchesTheGreedyDefinition)
 
 TEST(Halftone, CountFallsAsThresholdRises)
 {
-  const Grid g = Grid2(128, 128);
+  const ImageGeometry g = Grid2(128, 128);
   std::vector<float> rho(g.Size());
   for (int j = 0; j < 128; ++j)
     for (int i = 0; i < 128; ++i)
@@ -197,7 +198,7 @@ TEST(Hessian, LargestAbsEigenvalueMatchesEigen)
 
 TEST(FeatureNodes, CornersAreNodesAndOneNodePerVoxel)
 {
-  const Grid g = Grid2(50, 40);
+  const ImageGeometry g = Grid2(50, 40);
   const std::vector<float> f = Disk(g, 25, 20, 10);
   FeatureNodeParameters p;
   p.GaussianSigma = p.HessianSigma = 0.0; // the disk is used as it is
@@ -209,7 +210,7 @@ TEST(FeatureNodes, CornersAreNodesAndOneNodePerVoxel)
   EXPECT_EQ(seen[g.Index(49, 0, 0)], 1);
   EXPECT_EQ(seen[g.Index(0, 39, 0)], 1);
   EXPECT_EQ(seen[g.Index(49, 39, 0)], 1);
-  EXPECT_GT(r.Counts[NodeCanny], 0);
+  EXPECT_GT(r.Counts[int(NodeType::Canny)], 0);
 }
 
 TEST(FeatureNodes, VolumeNodesDoNotDependOnHowLoopsAreSplit)
@@ -217,7 +218,7 @@ TEST(FeatureNodes, VolumeNodesDoNotDependOnHowLoopsAreSplit)
   // A noisy ball in a box: the 3D paths (slice-blocked Gaussian, 26-connected hysteresis, packed
   // PCA rows, 3D halftone). A parallel-for that runs small chunks in reverse order stands in for
   // threads; results must equal the serial run bit for bit.
-  Grid g;
+  ImageGeometry g;
   g.Dims = { { 37, 29, 23 } };
   std::vector<float> f(g.Size());
   std::mt19937 rng(5);
@@ -236,7 +237,7 @@ TEST(FeatureNodes, VolumeNodesDoNotDependOnHowLoopsAreSplit)
   EXPECT_EQ(serial.Positions, split.Positions);
   EXPECT_EQ(serial.Type, split.Type);
   EXPECT_EQ(serial.EdgeMap, split.EdgeMap);
-  EXPECT_GT(serial.Counts[NodeCanny], 20);
+  EXPECT_GT(serial.Counts[int(NodeType::Canny)], 20);
   std::vector<int> seen(g.Size(), 0);
   for (const auto& x : serial.Positions)
     EXPECT_EQ(seen[g.Index(x[0], x[1], x[2])]++, 0);
@@ -247,7 +248,7 @@ TEST(FeatureNodes, VolumeNodesDoNotDependOnHowLoopsAreSplit)
   // Canny nodes lie on the ball's surface (within a voxel and a half).
   for (size_t t = 0; t < serial.Positions.size(); ++t)
   {
-    if (serial.Type[t] != NodeCanny)
+    if (serial.Type[t] != NodeType::Canny)
       continue;
     const auto& x = serial.Positions[t];
     EXPECT_NEAR(std::hypot(x[0] - 18.0, x[1] - 14.0, x[2] - 11.0), 8.0, 1.5);
@@ -270,7 +271,7 @@ class Tiling : public ::testing::TestWithParam<int>
 TEST_P(Tiling, EveryCentreHasExactlyOneOwner)
 {
   const int mode = GetParam(); // 0: 2D, 1: TetGen, 2: CGAL
-  Grid g;
+  ImageGeometry g;
   g.Dims = mode == 0 ? std::array<int, 3>{ { 40, 30, 1 } } : std::array<int, 3>{ { 14, 12, 10 } };
   std::mt19937 rng(7);
   std::vector<std::array<double, 3>> pts;
@@ -302,14 +303,15 @@ TEST_P(Tiling, EveryCentreHasExactlyOneOwner)
   }
   const double box = (g.Dims[0] - 1.0) * (g.Dims[1] - 1.0) * (mode == 0 ? 1.0 : g.Dims[2] - 1.0);
   EXPECT_NEAR(measure, box, 1e-9 * box);
-  ElementRasterizer raster(mesh.Points, mesh.Cells, mesh.VerticesPerCell, g);
+  const SimplexMesh simplices(g, mesh.Points, mesh.Cells, mesh.VerticesPerCell);
+  ElementRasterizer raster(simplices);
   std::vector<int> owners(g.Size(), 0);
   for (std::int64_t e = 0; e < raster.NumberOfElements(); ++e)
     raster.ForEachVoxel(e, [&](std::int64_t v) { owners[v]++; });
   for (std::int64_t v = 0; v < g.Size(); ++v)
     ASSERT_EQ(owners[v], 1) << "voxel " << v;
   // Hull faces cover the box surface: their measure sums to its area/perimeter.
-  const MeshAdjacency adj = BuildAdjacency(mesh.Points, mesh.Cells, mesh.VerticesPerCell);
+  const FaceAdjacency& adj = simplices.Faces();
   EXPECT_EQ(2 * adj.A.size() + adj.HullElement.size(), mesh.Cells.size());
 }
 INSTANTIATE_TEST_SUITE_P(Delaunay, Tiling, ::testing::Values(0, 1, 2));
@@ -329,7 +331,7 @@ TEST(Delaunay, DegenerateInputIsAnError)
 
 TEST(Statistics, MeanAndCountAreExact)
 {
-  Grid g;
+  ImageGeometry g;
   g.Dims = { { 5, 4, 1 } };
   std::vector<std::array<double, 3>> pts = { { { 0, 0, 0 } }, { { 4, 0, 0 } }, { { 4, 3, 0 } }, { { 0, 3, 0 } } };
   const DelaunayResult mesh = Triangulate2D(pts);
@@ -337,8 +339,8 @@ TEST(Statistics, MeanAndCountAreExact)
   std::vector<double> values(g.Size());
   for (std::int64_t v = 0; v < g.Size(); ++v)
     values[v] = static_cast<double>(v);
-  ElementRasterizer raster(mesh.Points, mesh.Cells, 3, g);
-  const auto s = ComputeElementStatistics(raster, mesh.Points, mesh.Cells, 3, values.data(), g, SerialFor());
+  const SimplexMesh simplices(g, mesh.Points, mesh.Cells, 3);
+  const auto s = ComputeElementStatistics(ElementRasterizer(simplices), values.data(), SerialFor());
   std::int64_t total = 0;
   double sum = 0.0;
   for (size_t e = 0; e < s.PixelCount.size(); ++e)

@@ -46,7 +46,8 @@ for case, backends in (("nuclei-dsb2018", [0]), ("liver-ct-totalseg", [0, 1])):
         ft.check(abs(m.sum() - box) <= 1e-9 * box, "%s: element measures sum to the box (rel. err %.1e)" % (tag, abs(m.sum() - box) / box))
         ft.check(m.min() > 0, "%s: no element of zero or negative measure (min %.3g)" % (tag, m.min()))
         ft.check(np.array_equal(P[: len(node_pts)], node_pts), "%s: every input node is a mesh point, in order" % tag)
-        for name in ("MeanIntensity", "IntensityStdDev", "Interpolated", "Quality", "RadiusRatio"):
+        quality = "MinAngle" if dims[2] == 1 else "MinDihedralAngle"
+        for name in ("MeanIntensity", "IntensityStdDev", "Interpolated", quality, "RadiusRatio"):
             ft.check(ug.GetCellData().GetArray(name) is not None, "%s: cell array %s" % (tag, name))
         # Brute-force means on elements whose voxel centres all lie strictly inside (no ties).
         mean = ft.array(ug, "MeanIntensity", cells=True)
@@ -86,7 +87,7 @@ for case, backends in (("nuclei-dsb2018", [0]), ("liver-ct-totalseg", [0, 1])):
             dist = np.linalg.norm(P[:, : len(centre)] - centre, axis=1)
             bad += int((dist < r * (1 - 1e-9)).sum())
         ft.check(bad == 0, "%s: Delaunay property on 200 sampled elements" % tag)
-        ft.check(ft.array(ug, "Quality", cells=True).min() > 0, "%s: positive minimum angle / dihedral" % tag)
+        ft.check(ft.array(ug, quality, cells=True).min() > 0, "%s: positive minimum angle / dihedral" % tag)
 
 # Bad input: each an error with empty output.
 d, image, truth = ft.open_case("nuclei-dsb2018")

@@ -1,0 +1,68 @@
+// The contract between FeatureMesh stages in code: every array and field-data name, node types and
+// label values. docs/CONTRACT.md says the same in words; change both together.
+#pragma once
+
+#include <cstdint>
+
+namespace featuremesh
+{
+// NodeType point array values (stage 1 writes 0-3, stage 2 adds 4).
+enum class NodeType : std::uint8_t
+{
+  Canny = 0,
+  Halftone = 1,
+  Uniform = 2,
+  Boundary = 3,
+  Added = 4
+};
+
+// Label cell / voxel values of the cuts.
+constexpr std::uint8_t LabelBackground = 0;
+constexpr std::uint8_t LabelObject = 1;
+
+namespace names
+{
+// Point arrays of nodes and mesh points.
+constexpr const char* NodeType = "NodeType";         // uint8, NodeType
+constexpr const char* Fixed = "Fixed";               // uint8, 1 = smoothing must not move the node
+constexpr const char* SampleRadius = "SampleRadius"; // float, voxels
+// Cell arrays of the image mesh (stages 2, 3).
+constexpr const char* PixelCount = "PixelCount";           // voxel centres the element owns
+constexpr const char* MeanIntensity = "MeanIntensity";     // over those voxels
+constexpr const char* IntensityStdDev = "IntensityStdDev"; // over those voxels
+constexpr const char* Interpolated = "Interpolated";       // 1 = owns no voxel; mean interpolated at its centroid
+constexpr const char* MinAngle = "MinAngle";               // triangles, degrees
+constexpr const char* MinDihedralAngle = "MinDihedralAngle"; // tetrahedra, degrees
+constexpr const char* RadiusRatio = "RadiusRatio";         // 1 = equilateral
+// Cut outputs: cell array of the labelled mesh, point array of the label images.
+constexpr const char* Label = "Label";
+// Stage 1's edge-map image.
+constexpr const char* EdgeMap = "EdgeMap";
+
+// Field data: the image frame a mesh was made on (3, 3, 3 and 9 components; direction row-major).
+constexpr const char* ImageOrigin = "ImageOrigin";
+constexpr const char* ImageSpacing = "ImageSpacing";
+constexpr const char* ImageDimensions = "ImageDimensions";
+constexpr const char* ImageDirection = "ImageDirection";
+// Field data: summaries.
+constexpr const char* NodeCounts = "NodeCounts";   // stage 1, per type
+constexpr const char* StepSeconds = "StepSeconds"; // stage 1, per step
+constexpr const char* NumberOfNodes = "NumberOfNodes";
+constexpr const char* NumberOfElements = "NumberOfElements";
+constexpr const char* AddedNodes = "AddedNodes";
+constexpr const char* MaxOfMinAngles = "MaxOfMinAngles";
+constexpr const char* MaxOfMinDihedralAngles = "MaxOfMinDihedralAngles";
+constexpr const char* DelaunayBackend = "DelaunayBackend"; // 0 TetGen, 1 CGAL (2D is always CGAL)
+constexpr const char* DelaunaySeconds = "DelaunaySeconds";
+constexpr const char* StatisticsSeconds = "StatisticsSeconds";
+constexpr const char* TotalSeconds = "TotalSeconds";
+constexpr const char* Sigma = "Sigma";
+constexpr const char* Bins = "Bins";
+constexpr const char* Flow = "Flow";
+constexpr const char* ObjectElements = "ObjectElements";
+constexpr const char* SetupSeconds = "SetupSeconds";
+constexpr const char* GraphSeconds = "GraphSeconds";
+constexpr const char* FlowSeconds = "FlowSeconds";
+constexpr const char* CutTotalSeconds = "CutTotalSeconds";
+} // namespace names
+} // namespace featuremesh

@@ -1,0 +1,328 @@
+#include "SimplexMesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace featuremesh
+{
+namespace
+{
+double FaceMeasure(const std::vector<std::array<double, 3>>& P, const std::int64_t* f, int n)
+{
+  const auto& a = P[f[0]];
+  const auto& b = P[f[1]];
+  const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+  if (n == 2)
+  {
+    return std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+  }
+  const auto& c = P[f[2]];
+  const double v[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+  const double x = u[1] * v[2] - u[2] * v[1], y = u[2] * v[0] - u[0] * v[2], z = u[0] * v[1] - u[1] * v[0];
+  return 0.5 * std::sqrt(x * x + y * y + z * z);
+}
+} // namespace
+
+void OutwardFace(const std::vector<std::array<double, 3>>& P, const std::int64_t* cell, int vpc, int f,
+  std::int64_t* face)
+{
+  if (vpc == 3)
+  {
+    // Counter-clockwise triangle: edge (f+1 -> f+2) has the triangle on its left.
+    face[0] = cell[(f + 1) % 3];
+    face[1] = cell[(f + 2) % 3];
+    return;
+  }
+  face[0] = cell[(f + 1) % 4];
+  face[1] = cell[(f + 2) % 4];
+  face[2] = cell[(f + 3) % 4];
+  const auto& a = P[face[0]];
+  const auto& b = P[face[1]];
+  const auto& c = P[face[2]];
+  const auto& o = P[cell[f]];
+  const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+  const double v[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+  const double n[3] = { u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0] };
+  if (n[0] * (o[0] - a[0]) + n[1] * (o[1] - a[1]) + n[2] * (o[2] - a[2]) > 0)
+  {
+    std::swap(face[1], face[2]);
+  }
+}
+
+namespace
+{
+FaceAdjacency BuildFaces(
+  const std::vector<std::array<double, 3>>& P, const std::vector<std::int64_t>& cells, int vpc)
+{
+  FaceAdjacency adj;
+  const std::int64_t m = static_cast<std::int64_t>(cells.size()) / vpc;
+  const int fv = vpc - 1; // vertices per face
+  const std::int64_t nFaces = m * vpc;
+  struct Face
+  {
+    std::int64_t v[3];
+    std::int64_t element;
+    int local;
+  };
+  std::vector<Face> faces(nFaces);
+  std::vector<std::int64_t> bucketStart(P.size() + 1, 0);
+  for (std::int64_t e = 0; e < m; ++e)
+  {
+    for (int f = 0; f < vpc; ++f)
+    {
+      Face& face = faces[e * vpc + f];
+      int k = 0;
+      for (int v = 0; v < vpc; ++v)
+      {
+        if (v != f)
+        {
+          face.v[k++] = cells[e * vpc + v];
+        }
+      }
+      if (fv == 2)
+      {
+        face.v[2] = -1;
+      }
+      std::sort(face.v, face.v + fv);
+      face.element = e;
+      face.local = f;
+      bucketStart[face.v[0] + 1]++;
+    }
+  }
+  for (size_t i = 1; i < bucketStart.size(); ++i)
+  {
+    bucketStart[i] += bucketStart[i - 1];
+  }
+  std::vector<std::int64_t> order(nFaces);
+  {
+    std::vector<std::int64_t> fill(bucketStart.begin(), bucketStart.end() - 1);
+    for (std::int64_t i = 0; i < nFaces; ++i)
+    {
+      order[fill[faces[i].v[0]]++] = i;
+    }
+  }
+  for (size_t b = 0; b + 1 < bucketStart.size(); ++b)
+  {
+    auto first = order.begin() + bucketStart[b], last = order.begin() + bucketStart[b + 1];
+    std::sort(first, last, [&](std::int64_t x, std::int64_t y) {
+      const Face &p = faces[x], &q = faces[y];
+      return std::make_pair(p.v[1], p.v[2]) < std::make_pair(q.v[1], q.v[2]) ||
+        (std::make_pair(p.v[1], p.v[2]) == std::make_pair(q.v[1], q.v[2]) && x < y);
+    });
+    for (auto it = first; it != last;)
+    {
+      const Face& p = faces[*it];
+      if (it + 1 != last && faces[*(it + 1)].v[1] == p.v[1] && faces[*(it + 1)].v[2] == p.v[2])
+      {
+        const Face& q = faces[*(it + 1)];
+        const bool pFirst = p.element < q.element;
+        adj.A.push_back(pFirst ? p.element : q.element);
+        adj.B.push_back(pFirst ? q.element : p.element);
+        adj.LocalA.push_back(static_cast<std::uint8_t>(pFirst ? p.local : q.local));
+        adj.LocalB.push_back(static_cast<std::uint8_t>(pFirst ? q.local : p.local));
+        adj.Measure.push_back(FaceMeasure(P, p.v, fv));
+        it += 2;
+      }
+      else
+      {
+        adj.HullElement.push_back(p.element);
+        adj.HullFace.push_back(static_cast<std::uint8_t>(p.local));
+        ++it;
+      }
+    }
+  }
+  return adj;
+}
+} // namespace
+
+double ElementMeasure(const std::vector<std::array<double, 3>>& P, const std::int64_t* c, int vpc)
+{
+  const auto& a = P[c[0]];
+  const auto& b = P[c[1]];
+  const auto& d = P[c[2]];
+  if (vpc == 3)
+  {
+    return 0.5 * ((b[0] - a[0]) * (d[1] - a[1]) - (b[1] - a[1]) * (d[0] - a[0]));
+  }
+  const auto& e = P[c[3]];
+  const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+  const double v[3] = { d[0] - a[0], d[1] - a[1], d[2] - a[2] };
+  const double w[3] = { e[0] - a[0], e[1] - a[1], e[2] - a[2] };
+  return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+           u[2] * (v[0] * w[1] - v[1] * w[0])) /
+    6.0;
+}
+
+SimplexMesh::SimplexMesh(const ImageGeometry& geometry, std::vector<std::array<double, 3>> indexPoints,
+  std::vector<std::int64_t> cells, int verticesPerCell)
+  : Frame(geometry)
+  , IndexPoints(std::move(indexPoints))
+  , CellIds(std::move(cells))
+  , Vpc(verticesPerCell)
+{
+}
+
+std::vector<std::array<double, 3>> SimplexMesh::FramePoints() const
+{
+  std::vector<std::array<double, 3>> frame(this->IndexPoints.size());
+  for (std::size_t i = 0; i < frame.size(); ++i)
+  {
+    frame[i] = this->Frame.IndexToFrame(this->IndexPoints[i]);
+  }
+  return frame;
+}
+
+std::vector<std::array<double, 3>> SimplexMesh::WorldPoints() const
+{
+  std::vector<std::array<double, 3>> world(this->IndexPoints.size());
+  for (std::size_t i = 0; i < world.size(); ++i)
+  {
+    world[i] = this->Frame.IndexToWorld(this->IndexPoints[i]);
+  }
+  return world;
+}
+
+std::string SimplexMesh::Validate() const
+{
+  if (this->Vpc != 3 && this->Vpc != 4)
+  {
+    return "the mesh must consist of triangles (2D) or tetrahedra (3D).";
+  }
+  if ((this->Vpc == 3) != this->Frame.Is2D())
+  {
+    return std::string("a ") + (this->Vpc == 3 ? "triangle mesh needs a 2D image." : "tetrahedral mesh needs a 3D image.");
+  }
+  if (this->CellIds.empty())
+  {
+    return "the mesh has no elements.";
+  }
+  const std::int64_t n = this->NumberOfPoints();
+  std::int64_t bad = 0;
+  for (std::int64_t id : this->CellIds)
+  {
+    bad += (id < 0 || id >= n) ? 1 : 0;
+  }
+  if (bad)
+  {
+    return std::to_string(bad) + " cell point ids lie outside the mesh's " + std::to_string(n) + " points.";
+  }
+  return std::string();
+}
+
+void SimplexMesh::SetPoints(std::vector<std::array<double, 3>> indexPoints)
+{
+  this->IndexPoints = std::move(indexPoints);
+  // Topology caches stay valid; face measures do not. A fresh cache keeps copies that share the
+  // old one unaffected.
+  auto fresh = std::make_shared<Cache>();
+  {
+    std::lock_guard<std::mutex> lock(this->Cached->Lock);
+    fresh->Stars = this->Cached->Stars;
+    fresh->Neighbours = this->Cached->Neighbours;
+  }
+  this->Cached = fresh;
+}
+
+const FaceAdjacency& SimplexMesh::Faces() const
+{
+  std::lock_guard<std::mutex> lock(this->Cached->Lock);
+  if (!this->Cached->Faces)
+  {
+    this->Cached->Faces = std::make_shared<const FaceAdjacency>(BuildFaces(this->FramePoints(), this->CellIds, this->Vpc));
+  }
+  return *this->Cached->Faces;
+}
+
+const CompressedRows& SimplexMesh::Stars() const
+{
+  std::lock_guard<std::mutex> lock(this->Cached->Lock);
+  if (!this->Cached->Stars)
+  {
+    // Two passes, count then insert; elements go in ascending order.
+    auto rows = std::make_shared<CompressedRows>();
+    rows->Offsets.assign(this->IndexPoints.size() + 1, 0);
+    for (std::int64_t id : this->CellIds)
+    {
+      rows->Offsets[id + 1]++;
+    }
+    std::partial_sum(rows->Offsets.begin(), rows->Offsets.end(), rows->Offsets.begin());
+    rows->Ids.resize(this->CellIds.size());
+    std::vector<std::int64_t> fill(rows->Offsets.begin(), rows->Offsets.end() - 1);
+    for (std::size_t k = 0; k < this->CellIds.size(); ++k)
+    {
+      rows->Ids[fill[this->CellIds[k]]++] = static_cast<std::int64_t>(k) / this->Vpc;
+    }
+    this->Cached->Stars = rows;
+  }
+  return *this->Cached->Stars;
+}
+
+const CompressedRows& SimplexMesh::VertexNeighbours() const
+{
+  const CompressedRows& stars = this->Stars();
+  std::lock_guard<std::mutex> lock(this->Cached->Lock);
+  if (!this->Cached->Neighbours)
+  {
+    auto rows = std::make_shared<CompressedRows>();
+    const std::int64_t n = this->NumberOfPoints();
+    rows->Offsets.assign(n + 1, 0);
+    std::vector<std::int64_t> around;
+    for (std::int64_t v = 0; v < n; ++v)
+    {
+      around.clear();
+      for (const std::int64_t* e = stars.Begin(v); e != stars.End(v); ++e)
+      {
+        for (int k = 0; k < this->Vpc; ++k)
+        {
+          const std::int64_t w = this->CellIds[*e * this->Vpc + k];
+          if (w != v)
+          {
+            around.push_back(w);
+          }
+        }
+      }
+      std::sort(around.begin(), around.end());
+      around.erase(std::unique(around.begin(), around.end()), around.end());
+      rows->Ids.insert(rows->Ids.end(), around.begin(), around.end());
+      rows->Offsets[v + 1] = static_cast<std::int64_t>(rows->Ids.size());
+    }
+    this->Cached->Neighbours = rows;
+  }
+  return *this->Cached->Neighbours;
+}
+
+std::vector<std::int64_t> LabelBoundaryFaces(const SimplexMesh& mesh, const std::vector<std::uint8_t>& label)
+{
+  const FaceAdjacency& adj = mesh.Faces();
+  const std::vector<std::array<double, 3>> frame = mesh.FramePoints();
+  const int vpc = mesh.VerticesPerCell();
+  const bool flip = mesh.Geometry().IsMirrored();
+  std::vector<std::int64_t> faces;
+  auto add = [&](std::int64_t element, int local) {
+    std::int64_t f[3];
+    OutwardFace(frame, mesh.Cell(element), vpc, local, f);
+    if (flip)
+    {
+      std::swap(f[0], f[1]);
+    }
+    faces.insert(faces.end(), f, f + vpc - 1);
+  };
+  for (std::size_t e = 0; e < adj.A.size(); ++e)
+  {
+    const std::uint8_t la = label[adj.A[e]], lb = label[adj.B[e]];
+    if (la != lb)
+    {
+      la ? add(adj.A[e], adj.LocalA[e]) : add(adj.B[e], adj.LocalB[e]);
+    }
+  }
+  for (std::size_t h = 0; h < adj.HullElement.size(); ++h)
+  {
+    if (label[adj.HullElement[h]])
+    {
+      add(adj.HullElement[h], adj.HullFace[h]);
+    }
+  }
+  return faces;
+}
+} // namespace featuremesh

@@ -1,0 +1,228 @@
+#include "SuperVoxelCut.h"
+
+#include "ElementRasterizer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace featuremesh
+{
+bool SeedConstraints(const std::vector<std::int64_t>& owner, const std::vector<std::int64_t>& objectVoxels,
+  const std::vector<std::int64_t>& backgroundVoxels, const char* node, std::vector<std::uint8_t>& hard,
+  std::string& error)
+{
+  for (std::int64_t v : objectVoxels)
+  {
+    if (owner[v] < 0)
+    {
+      error = "an object seed lies outside the mesh.";
+      return false;
+    }
+    hard[owner[v]] = 1;
+  }
+  for (std::int64_t v : backgroundVoxels)
+  {
+    if (owner[v] < 0)
+    {
+      error = "a background seed lies outside the mesh.";
+      return false;
+    }
+    if (hard[owner[v]] == 1)
+    {
+      error = std::string(node) + " " + std::to_string(owner[v]) +
+        " holds both an object and a background seed; move one of them.";
+      return false;
+    }
+    hard[owner[v]] = 2;
+  }
+  return true;
+}
+
+std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale)
+{
+  const FaceAdjacency& adj = mesh.Faces();
+  const auto& s = mesh.Geometry().Spacing;
+  const double sx = std::fabs(s[0]), sy = std::fabs(s[1]), sz = std::fabs(s[2]);
+  const double unit = mesh.VerticesPerCell() == 3 ? 0.5 * (sx + sy) : std::pow(sx * sy * sz, 2.0 / 3.0);
+  std::vector<double> contact(adj.Measure.size(), 1.0);
+  if (scale)
+  {
+    for (std::size_t e = 0; e < contact.size(); ++e)
+    {
+      contact[e] = adj.Measure[e] / unit;
+    }
+  }
+  return contact;
+}
+
+SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<double>& mean,
+  const std::vector<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
+  const std::vector<std::int64_t>& backgroundVoxels, const double* voxelValues,
+  const SuperVoxelCutParameters& parameters, const ParallelFor& parallel)
+{
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  SuperVoxelCutResult result;
+  const std::int64_t m = mesh.NumberOfElements();
+  const ElementRasterizer raster(mesh);
+  result.VoxelOwner = VoxelOwners(raster, parallel);
+  const std::vector<std::int64_t>& owner = result.VoxelOwner;
+
+  CutProblem pr;
+  pr.Hard.assign(m, 0);
+  if (!SeedConstraints(owner, objectVoxels, backgroundVoxels, "element", pr.Hard, result.Error))
+  {
+    return result;
+  }
+  pr.Value = mean;
+  pr.Size.resize(m);
+  for (std::int64_t c = 0; c < m; ++c)
+  {
+    pr.Size[c] = std::max(0.0, voxelCount[c]);
+  }
+  const FaceAdjacency& adj = mesh.Faces();
+  pr.A = adj.A;
+  pr.B = adj.B;
+  pr.Contact = ContactInVoxelFaces(mesh, parameters.ScaleByContact);
+  // Seed histograms: the voxels of the seed elements when the values are there, else their means
+  // weighted by their voxel counts.
+  if (voxelValues)
+  {
+    const std::int64_t n = mesh.Geometry().Size();
+    for (std::int64_t v = 0; v < n; ++v)
+    {
+      const std::int64_t e = owner[v];
+      if (e >= 0 && pr.Hard[e])
+      {
+        (pr.Hard[e] == 1 ? pr.ObjectSamples : pr.BackgroundSamples).push_back(voxelValues[v]);
+      }
+    }
+    if (parameters.VoxelRegionTerm)
+    {
+      pr.PixelValue = voxelValues;
+      pr.PixelOwner = owner.data();
+      pr.PixelTotal = n;
+    }
+  }
+  else
+  {
+    for (std::int64_t c = 0; c < m; ++c)
+    {
+      if (pr.Hard[c])
+      {
+        (pr.Hard[c] == 1 ? pr.ObjectSamples : pr.BackgroundSamples).push_back(pr.Value[c]);
+        (pr.Hard[c] == 1 ? pr.ObjectWeights : pr.BackgroundWeights).push_back(std::max(1.0, pr.Size[c]));
+      }
+    }
+  }
+  result.SetupSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  result.Cut = BoykovJollyCut(pr, parameters);
+  if (!result.Cut.Error.empty())
+  {
+    result.Error = result.Cut.Error;
+    return result;
+  }
+  result.BoundaryFaces = LabelBoundaryFaces(mesh, result.Cut.Label);
+  return result;
+}
+
+std::vector<std::uint8_t> VoxelLabels(const std::vector<std::int64_t>& owner, const std::vector<std::uint8_t>& label,
+  const ParallelFor& parallel)
+{
+  std::vector<std::uint8_t> out(owner.size());
+  parallel(static_cast<std::int64_t>(owner.size()), 65536, [&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t v = b; v < e; ++v)
+    {
+      out[v] = owner[v] >= 0 ? label[owner[v]] : 0;
+    }
+  });
+  return out;
+}
+
+std::string ValidateParameters(const VoxelCutParameters& p)
+{
+  std::string error = ValidateParameters(static_cast<const BoykovJollyParameters&>(p));
+  if (error.empty() && !(p.SeedRadius >= 0.0 && p.SeedRadius <= 50.0))
+  {
+    error = "the seed radius must lie in [0, 50] voxels.";
+  }
+  return error;
+}
+
+CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
+  const std::vector<std::int64_t>& objectVoxels, const std::vector<std::int64_t>& backgroundVoxels,
+  const VoxelCutParameters& parameters)
+{
+  CutResult failed;
+  const std::int64_t n = g.Size();
+  CutProblem pr;
+  pr.Value = std::move(values);
+  pr.Hard.assign(n, 0);
+  for (std::int64_t v : objectVoxels)
+  {
+    pr.Hard[v] = 1;
+  }
+  for (std::int64_t v : backgroundVoxels)
+  {
+    if (pr.Hard[v] == 1)
+    {
+      failed.Error = "a voxel is seeded both as object and as background; move one of the seeds.";
+      return failed;
+    }
+    pr.Hard[v] = 2;
+  }
+  // Seed neighbourhoods: voxels within SeedRadius of each seed voxel.
+  const double radius = parameters.SeedRadius;
+  const int r = static_cast<int>(std::floor(radius));
+  auto gather = [&](const std::vector<std::int64_t>& voxels, std::vector<double>& samples) {
+    for (std::int64_t v : voxels)
+    {
+      const int k = static_cast<int>(v / g.SliceStride());
+      const int j = static_cast<int>((v % g.SliceStride()) / g.Dims[0]);
+      const int i = static_cast<int>(v % g.Dims[0]);
+      const int rk = g.Is2D() ? 0 : r;
+      for (int dk = -rk; dk <= rk; ++dk)
+        for (int dj = -r; dj <= r; ++dj)
+          for (int di = -r; di <= r; ++di)
+          {
+            if (di * di + dj * dj + dk * dk <= radius * radius && g.Contains(i + di, j + dj, k + dk))
+            {
+              samples.push_back(pr.Value[g.Index(i + di, j + dj, k + dk)]);
+            }
+          }
+    }
+  };
+  gather(objectVoxels, pr.ObjectSamples);
+  gather(backgroundVoxels, pr.BackgroundSamples);
+  pr.Size.assign(n, 1.0);
+  const std::int64_t sx = 1, sy = g.Dims[0], sz = g.SliceStride();
+  const std::int64_t edges = (g.Dims[0] - 1) * std::int64_t(g.Dims[1]) * g.Dims[2] +
+    std::int64_t(g.Dims[0]) * (g.Dims[1] - 1) * g.Dims[2] + (g.Is2D() ? 0 : sz * (g.Dims[2] - 1));
+  pr.A.reserve(edges);
+  pr.B.reserve(edges);
+  for (int k = 0; k < g.Dims[2]; ++k)
+    for (int j = 0; j < g.Dims[1]; ++j)
+      for (int i = 0; i < g.Dims[0]; ++i)
+      {
+        const std::int64_t v = g.Index(i, j, k);
+        if (i + 1 < g.Dims[0])
+        {
+          pr.A.push_back(v);
+          pr.B.push_back(v + sx);
+        }
+        if (j + 1 < g.Dims[1])
+        {
+          pr.A.push_back(v);
+          pr.B.push_back(v + sy);
+        }
+        if (k + 1 < g.Dims[2])
+        {
+          pr.A.push_back(v);
+          pr.B.push_back(v + sz);
+        }
+      }
+  pr.Contact.assign(pr.A.size(), 1.0);
+  return BoykovJollyCut(pr, parameters);
+}
+} // namespace featuremesh

@@ -1,0 +1,76 @@
+// Stage 4 without VTK: the Boykov-Jolly cut (BoykovJolly.h) on the elements of a mesh (super-voxel
+// cut) and on the voxel grid (voxel cut), from seed voxels. The two build their graphs here and
+// share the energy, so a comparison of the two compares the graphs, nothing else.
+#pragma once
+
+#include "BoykovJolly.h"
+#include "Parallel.h"
+#include "SimplexMesh.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace featuremesh
+{
+struct SuperVoxelCutParameters : BoykovJollyParameters
+{
+  // Boundary weights scaled by the shared edge length / face area in voxel-face units: the
+  // element energy is then the voxel cut's energy on super-voxels, so lambda and sigma mean the
+  // same in both.
+  bool ScaleByContact = true;
+  // With voxel values given: an element's region cost is the sum of its voxels' costs rather than
+  // its voxel count times the cost of its mean.
+  bool VoxelRegionTerm = true;
+};
+
+struct VoxelCutParameters : BoykovJollyParameters
+{
+  // Radius (voxels) of the neighbourhood of each seed whose voxels build the histograms: about the
+  // voxels of a seed element of the super-voxel cut.
+  double SeedRadius = 2.0;
+};
+
+struct SuperVoxelCutResult
+{
+  CutResult Cut;
+  // Owner element of every voxel (-1 where the mesh does not cover it).
+  std::vector<std::int64_t> VoxelOwner;
+  // LabelBoundaryFaces of the labels.
+  std::vector<std::int64_t> BoundaryFaces;
+  double SetupSeconds = 0.0;
+  std::string Error;
+};
+
+// Hard constraints (0 free, 1 object, 2 background) of the nodes owning the seed voxels; false
+// with a sentence when a seed voxel has no owner (-1) or a node holds seeds of both kinds.
+// `node` names a node in messages ("element", "voxel").
+bool SeedConstraints(const std::vector<std::int64_t>& owner, const std::vector<std::int64_t>& objectVoxels,
+  const std::vector<std::int64_t>& backgroundVoxels, const char* node, std::vector<std::uint8_t>& hard,
+  std::string& error);
+
+// Contact of each interior face of the mesh in voxel faces: a 2D edge in pixel lengths, a 3D face in
+// voxel-face areas; 1 everywhere when `scale` is off.
+std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale);
+
+// The super-voxel cut. `mean` and `voxelCount` per element (stage 2's MeanIntensity and
+// PixelCount); `voxelValues` (optional, one per voxel of the mesh's image) gives the seed
+// histograms the voxels of the seed elements and enables the voxel region term.
+SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<double>& mean,
+  const std::vector<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
+  const std::vector<std::int64_t>& backgroundVoxels, const double* voxelValues,
+  const SuperVoxelCutParameters& parameters, const ParallelFor& parallel);
+
+// The labels of the elements on the voxel grid (0 where no element owns a voxel).
+std::vector<std::uint8_t> VoxelLabels(const std::vector<std::int64_t>& owner, const std::vector<std::uint8_t>& label,
+  const ParallelFor& parallel);
+
+// The voxel cut on the 4-/6-connected grid, each neighbour pair one voxel face; `values` (one per
+// voxel) is moved in, not copied.
+CutResult VoxelCut(std::vector<double> values, const ImageGeometry& geometry,
+  const std::vector<std::int64_t>& objectVoxels, const std::vector<std::int64_t>& backgroundVoxels,
+  const VoxelCutParameters& parameters);
+
+// Empty when usable, else a sentence.
+std::string ValidateParameters(const VoxelCutParameters& p);
+} // namespace featuremesh
