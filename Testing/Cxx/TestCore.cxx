@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <random>
 
@@ -433,4 +434,185 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   const CutResult exact = BoykovJollyCut(two, BoykovJollyParameters());
   ASSERT_TRUE(exact.Error.empty());
   EXPECT_EQ(exact.Label[2], 1);
+}
+
+// A rotated, offset, anisotropic frame: world -> index -> world round trips, voxel centres snap
+// back exactly, half a voxel of slack decides membership, a mirror is detected.
+TEST(ImageGeometry, OrientedFrameRoundTrips)
+{
+  ImageGeometry g;
+  g.Dims = { { 6, 5, 4 } };
+  g.Origin = { { 10.0, -3.0, 2.5 } };
+  g.Spacing = { { 0.5, 2.0, 1.25 } };
+  g.Direction = { { 0, -1, 0, 1, 0, 0, 0, 0, 1 } }; // 90 degrees about z
+  ASSERT_TRUE(g.Validate().empty());
+  EXPECT_FALSE(g.IsMirrored());
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 5; ++j)
+      for (int i = 0; i < 6; ++i)
+      {
+        const std::array<double, 3> idx = { { double(i), double(j), double(k) } };
+        EXPECT_EQ(g.WorldToIndex(g.IndexToWorld(idx)), idx);
+        EXPECT_EQ(g.VoxelAt(g.IndexToWorld(idx)), g.Index(i, j, k));
+      }
+  // Direction column 0 is (0, 1, 0): index x runs along world +y.
+  const auto w = g.IndexToWorld({ { 1, 0, 0 } });
+  EXPECT_DOUBLE_EQ(w[0], 10.0);
+  EXPECT_DOUBLE_EQ(w[1], -2.5);
+  EXPECT_EQ(g.VoxelAt(g.IndexToWorld({ { -0.49, 0, 0 } })), g.Index(0, 0, 0));
+  EXPECT_EQ(g.VoxelAt(g.IndexToWorld({ { -0.51, 0, 0 } })), -1);
+  EXPECT_EQ(g.VoxelAt(g.IndexToWorld({ { 5.4, 4, 3 } })), g.Index(5, 4, 3));
+  EXPECT_EQ(g.VoxelAt({ { std::nan(""), 0, 0 } }), -1);
+  std::vector<std::int64_t> voxels;
+  std::string error;
+  EXPECT_FALSE(SeedVoxels({ g.IndexToWorld({ { 1, 1, 1 } }), { { 1e9, 0, 0 } } }, g, "object", voxels, error));
+  EXPECT_EQ(error, "1 of 2 object seeds fall outside the image.");
+  EXPECT_FALSE(SeedVoxels({}, g, "background", voxels, error));
+  ImageGeometry m = g;
+  m.Spacing[1] = -2.0;
+  EXPECT_TRUE(m.IsMirrored());
+  m.Spacing[1] = 0.0;
+  EXPECT_FALSE(m.Validate().empty());
+  m = g;
+  m.Direction = { { 1, 0, 0, 1, 0, 0, 0, 0, 1 } };
+  EXPECT_FALSE(m.Validate().empty());
+}
+
+namespace
+{
+// Four triangles around the centre (2, 2) of a 5x5 image: 0 bottom, 1 right, 2 top, 3 left.
+SimplexMesh FourTriangles(double sx = 1.0, double sy = 1.0)
+{
+  ImageGeometry g = Grid2(5, 5);
+  g.Spacing = { { sx, sy, 1.0 } };
+  std::vector<std::array<double, 3>> p = { { { 0, 0, 0 } }, { { 4, 0, 0 } }, { { 4, 4, 0 } }, { { 0, 4, 0 } },
+    { { 2, 2, 0 } } };
+  std::vector<std::int64_t> c = { 0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4 };
+  return SimplexMesh(g, p, c, 3);
+}
+} // namespace
+
+TEST(SimplexMesh, AdjacencyOfFourTriangles)
+{
+  const SimplexMesh mesh = FourTriangles();
+  ASSERT_TRUE(mesh.Validate().empty());
+  const FaceAdjacency& f = mesh.Faces();
+  // Interior edges: the four spokes, each between neighbouring triangles; hull: the four sides.
+  ASSERT_EQ(f.A.size(), 4u);
+  ASSERT_EQ(f.HullElement.size(), 4u);
+  for (size_t e = 0; e < f.A.size(); ++e)
+  {
+    EXPECT_LT(f.A[e], f.B[e]);
+    EXPECT_TRUE((f.B[e] - f.A[e]) == 1 || (f.A[e] == 0 && f.B[e] == 3));
+    EXPECT_DOUBLE_EQ(f.Measure[e], std::sqrt(8.0));
+  }
+  const CompressedRows& stars = mesh.Stars();
+  EXPECT_EQ(stars.Size(4), 4);
+  EXPECT_EQ(std::vector<std::int64_t>(stars.Begin(0), stars.End(0)), (std::vector<std::int64_t>{ 0, 3 }));
+  const CompressedRows& around = mesh.VertexNeighbours();
+  EXPECT_EQ(std::vector<std::int64_t>(around.Begin(4), around.End(4)), (std::vector<std::int64_t>{ 0, 1, 2, 3 }));
+  EXPECT_EQ(std::vector<std::int64_t>(around.Begin(0), around.End(0)), (std::vector<std::int64_t>{ 1, 3, 4 }));
+  // Moving points keeps the topology, recomputes measures.
+  SimplexMesh moved = mesh;
+  auto p = moved.Points();
+  p[4] = { { 1, 1, 0 } };
+  moved.SetPoints(p);
+  EXPECT_DOUBLE_EQ(moved.Faces().Measure[0], std::sqrt(2.0));
+  EXPECT_DOUBLE_EQ(mesh.Faces().Measure[0], std::sqrt(8.0));
+  EXPECT_EQ(&moved.Stars(), &mesh.Stars());
+  // Bad ids are an error, not a crash.
+  EXPECT_FALSE(SimplexMesh(mesh.Geometry(), mesh.Points(), { 0, 1, 7 }, 3).Validate().empty());
+}
+
+TEST(SuperVoxelCut, ContactAndHardConstraintsOnFourTriangles)
+{
+  // Anisotropic pixels: a spoke of length sqrt(2^2 0.5^2 + 2^2 1.5^2) counts in units of the mean
+  // pixel edge (1.0).
+  const SimplexMesh mesh = FourTriangles(0.5, 1.5);
+  const std::vector<double> contact = ContactInVoxelFaces(mesh, true);
+  for (double c : contact)
+    EXPECT_DOUBLE_EQ(c, std::sqrt(1.0 + 9.0) / 1.0);
+  for (double c : ContactInVoxelFaces(mesh, false))
+    EXPECT_EQ(c, 1.0);
+
+  const ElementRasterizer raster(mesh);
+  const std::vector<std::int64_t> owner = VoxelOwners(raster, SerialFor());
+  const ImageGeometry& g = mesh.Geometry();
+  std::vector<std::uint8_t> hard(4, 0);
+  std::string error;
+  // Voxel (2, 0) lies in the bottom triangle, (4, 2) in the right one.
+  ASSERT_TRUE(SeedConstraints(owner, { g.Index(2, 0, 0) }, { g.Index(4, 2, 0) }, "element", hard, error));
+  EXPECT_EQ(hard, (std::vector<std::uint8_t>{ 1, 2, 0, 0 }));
+  hard.assign(4, 0);
+  EXPECT_FALSE(SeedConstraints(owner, { g.Index(2, 0, 0) }, { g.Index(1, 0, 0) }, "element", hard, error));
+  EXPECT_EQ(error, "element 0 holds both an object and a background seed; move one of them.");
+
+  // Bright bottom and left, dark right and top; seeds force bottom and right even when the
+  // intensities disagree (the background seed sits in a bright element).
+  const std::vector<double> mean = { 100, 10, 10, 100 }, count = { 9, 9, 9, 9 };
+  SuperVoxelCutParameters par;
+  const SuperVoxelCutResult r =
+    SuperVoxelCut(mesh, mean, count, { g.Index(2, 0, 0) }, { g.Index(4, 2, 0) }, nullptr, par, SerialFor());
+  ASSERT_TRUE(r.Error.empty()) << r.Error;
+  EXPECT_EQ(r.Cut.Label[0], LabelObject);
+  EXPECT_EQ(r.Cut.Label[1], LabelBackground);
+  EXPECT_EQ(r.Cut.Label[3], LabelObject);
+  const std::vector<std::uint8_t> voxels = VoxelLabels(r.VoxelOwner, r.Cut.Label, SerialFor());
+  EXPECT_EQ(voxels[g.Index(2, 0, 0)], LabelObject);
+  EXPECT_EQ(voxels[g.Index(4, 2, 0)], LabelBackground);
+}
+
+// The label boundary of a tetrahedral mesh is closed (every edge in two faces, with opposite
+// directions) and outward (it encloses the labelled volume, positively); a mirrored frame flips
+// the faces so that they stay outward in world coordinates.
+TEST(SimplexMesh, LabelBoundaryIsClosedAndOutward)
+{
+  ImageGeometry g;
+  g.Dims = { { 5, 5, 5 } };
+  g.Spacing = { { 1.0, 2.0, 0.5 } };
+  std::vector<std::array<double, 3>> pts;
+  for (int k = 0; k < 5; k += 2)
+    for (int j = 0; j < 5; j += 2)
+      for (int i = 0; i < 5; i += 2)
+        pts.push_back({ { double(i) + (i == 2 && j == 2 ? 0.5 : 0.0), double(j), double(k) } });
+  const DelaunayResult d = Tetrahedralize(pts, DelaunayOptions());
+  ASSERT_TRUE(d.Error.empty());
+  const SimplexMesh mesh(g, d.Points, d.Cells, 4);
+  const std::vector<std::array<double, 3>> frame = mesh.FramePoints();
+  std::vector<std::uint8_t> label(mesh.NumberOfElements());
+  double labelled = 0.0;
+  for (std::int64_t e = 0; e < mesh.NumberOfElements(); ++e)
+  {
+    double cx = 0.0;
+    for (int v = 0; v < 4; ++v)
+      cx += mesh.Points()[mesh.Cell(e)[v]][0] / 4;
+    label[e] = cx < 2.2 ? 1 : 0;
+    labelled += label[e] ? ElementMeasure(frame, mesh.Cell(e), 4) : 0.0;
+  }
+  for (const bool mirrored : { false, true })
+  {
+    ImageGeometry h = g;
+    h.Direction = mirrored ? std::array<double, 9>{ { -1, 0, 0, 0, 1, 0, 0, 0, 1 } } : g.Direction;
+    const SimplexMesh m(h, mesh.Points(), mesh.Cells(), 4);
+    const std::vector<std::int64_t> faces = LabelBoundaryFaces(m, label);
+    ASSERT_EQ(faces.size() % 3, 0u);
+    std::map<std::pair<std::int64_t, std::int64_t>, int> edges;
+    double enclosed = 0.0;
+    const std::vector<std::array<double, 3>> world = m.WorldPoints();
+    for (size_t f = 0; f < faces.size(); f += 3)
+    {
+      for (int k = 0; k < 3; ++k)
+        edges[{ faces[f + k], faces[f + (k + 1) % 3] }]++;
+      const auto &a = world[faces[f]], &b = world[faces[f + 1]], &c = world[faces[f + 2]];
+      enclosed += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                    a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
+    }
+    for (const auto& e : edges)
+    {
+      EXPECT_EQ(e.second, 1);
+      EXPECT_EQ(edges.count({ e.first.second, e.first.first }), 1u) << "open edge";
+    }
+    EXPECT_GT(labelled, 0.0);
+    EXPECT_NEAR(enclosed, labelled, 1e-9 * labelled) << (mirrored ? "mirrored" : "identity");
+  }
 }

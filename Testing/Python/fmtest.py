@@ -1,4 +1,5 @@
 """Shared helpers of the pvpython tests: plugin loading, data lookup, seeds, Dice, hashing."""
+import atexit
 import hashlib
 import os
 import shutil
@@ -74,8 +75,23 @@ def run_script_with_backend(script, backend, *args):
     return out.stdout.strip().splitlines()[-1]
 
 
+FAILURES = []
+
+
 def check(condition, message):
+    """Records a check; every failure is reported, and the test exits 1 at the end if any failed."""
     if not condition:
-        print("FAIL:", message)
-        sys.exit(1)
-    print("ok:", message)
+        FAILURES.append(message)
+        print("FAIL:", message, flush=True)
+        return False
+    print("ok:", message, flush=True)
+    return True
+
+
+def finish():
+    if FAILURES:
+        print("%d check(s) failed:\n  %s" % (len(FAILURES), "\n  ".join(FAILURES)), flush=True)
+        os._exit(1)
+
+
+atexit.register(finish)
