@@ -29,7 +29,7 @@ public:
   vtkTypeMacro(vtkFeatureNodes, vtkPolyDataAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
-  /// Standard deviation (voxels) of the Gaussian applied before Canny and the Hessian. Default 0.7.
+  /// Standard deviation (voxels) of the Gaussian applied before Canny. Default 0.7.
   vtkSetMacro(GaussianSigma, double);
   vtkGetMacro(GaussianSigma, double);
 

@@ -1,0 +1,112 @@
+// Every numeric property default in the plugin's XML equals the default of the VTK filter it sets
+// (which the filters take from the Core parameter structs): one source of truth, checked.
+#include "vtkDelaunayImageMesh.h"
+#include "vtkFeatureNodes.h"
+#include "vtkSuperVoxelCut.h"
+#include "vtkVoxelCut.h"
+
+#include "vtkNew.h"
+#include "vtkSmartPointer.h"
+#include "vtkXMLDataElement.h"
+#include "vtkXMLDataParser.h"
+
+#include <cstdlib>
+#include <functional>
+#include <iostream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+
+#define GETTER(cls, name)                                                                          \
+  {                                                                                                \
+    #cls "::" #name, []() {                                                                        \
+      vtkNew<cls> filter;                                                                          \
+      return static_cast<double>(filter->Get##name());                                             \
+    }                                                                                              \
+  }
+
+int main(int argc, char* argv[])
+{
+  if (argc < 2)
+  {
+    std::cerr << "usage: FeatureMeshDefaultsTest PLUGIN_DIR\n";
+    return 2;
+  }
+  const std::map<std::string, std::function<double()>> getters = {
+    GETTER(vtkFeatureNodes, GaussianSigma), GETTER(vtkFeatureNodes, HessianSigma),
+    GETTER(vtkFeatureNodes, LowThreshold), GETTER(vtkFeatureNodes, HighThreshold),
+    GETTER(vtkFeatureNodes, MaximumPercentile), GETTER(vtkFeatureNodes, CovarianceNeighbourhood),
+    GETTER(vtkFeatureNodes, Halftoning), GETTER(vtkFeatureNodes, HalftoneThreshold),
+    GETTER(vtkFeatureNodes, HalftoneGamma), GETTER(vtkFeatureNodes, ExclusionWindow),
+    GETTER(vtkFeatureNodes, UniformSpacing), GETTER(vtkFeatureNodes, BoundarySpacing),
+    GETTER(vtkDelaunayImageMesh, Backend), GETTER(vtkDelaunayImageMesh, QualityRefinement),
+    GETTER(vtkDelaunayImageMesh, RadiusEdgeRatio), GETTER(vtkDelaunayImageMesh, MinDihedralAngle),
+    GETTER(vtkSuperVoxelCut, Lambda), GETTER(vtkSuperVoxelCut, Sigma), GETTER(vtkSuperVoxelCut, Bins),
+    GETTER(vtkSuperVoxelCut, ScaleByContact), GETTER(vtkSuperVoxelCut, VoxelRegionTerm),
+    GETTER(vtkVoxelCut, Lambda), GETTER(vtkVoxelCut, Sigma), GETTER(vtkVoxelCut, Bins),
+    GETTER(vtkVoxelCut, SeedRadius),
+  };
+  int failures = 0, checked = 0;
+  std::set<std::string> seen;
+  for (const char* file : { "FeatureNodes.xml", "DelaunayImageMesh.xml", "SuperVoxelCut.xml" })
+  {
+    vtkNew<vtkXMLDataParser> parser;
+    const std::string path = std::string(argv[1]) + "/" + file;
+    parser->SetFileName(path.c_str());
+    if (!parser->Parse())
+    {
+      std::cerr << "FAIL: cannot parse " << path << "\n";
+      return 1;
+    }
+    vtkXMLDataElement* group = parser->GetRootElement()->FindNestedElementWithName("ProxyGroup");
+    for (int p = 0; group && p < group->GetNumberOfNestedElements(); ++p)
+    {
+      vtkXMLDataElement* proxy = group->GetNestedElement(p);
+      const std::string cls = proxy->GetAttribute("class") ? proxy->GetAttribute("class") : "";
+      for (int q = 0; q < proxy->GetNumberOfNestedElements(); ++q)
+      {
+        vtkXMLDataElement* property = proxy->GetNestedElement(q);
+        const std::string tag = property->GetName();
+        const char* command = property->GetAttribute("command");
+        const char* value = property->GetAttribute("default_values");
+        if ((tag != "IntVectorProperty" && tag != "DoubleVectorProperty") || !command || !value)
+        {
+          continue;
+        }
+        const std::string key = cls + "::" + std::string(command).substr(3);
+        seen.insert(key);
+        auto it = getters.find(key);
+        if (it == getters.end())
+        {
+          std::cout << "FAIL: " << file << ": " << key << " has an XML default and no C++ getter in this test\n";
+          ++failures;
+          continue;
+        }
+        double xml = 0.0;
+        std::istringstream(value) >> xml;
+        const double cxx = it->second();
+        ++checked;
+        if (xml != cxx)
+        {
+          std::cout << "FAIL: " << key << ": XML default " << value << ", C++ default " << cxx << "\n";
+          ++failures;
+        }
+        else
+        {
+          std::cout << "ok: " << key << " = " << cxx << "\n";
+        }
+      }
+    }
+  }
+  for (const auto& g : getters)
+  {
+    if (!seen.count(g.first))
+    {
+      std::cout << "FAIL: " << g.first << " is not a property with a default in the XML\n";
+      ++failures;
+    }
+  }
+  std::cout << checked << " defaults checked, " << failures << " failures\n";
+  return failures ? EXIT_FAILURE : EXIT_SUCCESS;
+}
