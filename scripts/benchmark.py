@@ -7,10 +7,10 @@ takes over 5 s) and writes it as Markdown and CSV.
 """
 import argparse
 import csv
-import glob
 import os
 import platform
 import statistics
+import sys
 import time
 
 from paraview import servermanager as sm
@@ -18,28 +18,11 @@ from paraview.simple import *  # noqa: F401,F403
 import paraview.simple as ps
 from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+import featuremesh as fm  # noqa: E402
+from featuremesh import dice, seeds  # noqa: E402
 
-
-def cases(selection):
-    found = {}
-    for root in (os.path.join(ROOT, "Data"), os.path.join(ROOT, "..", "shared", "data", "cases")):
-        if not os.path.isdir(root):
-            print("note: %s not found, its cases are skipped" % root)
-            continue
-        for d in sorted(glob.glob(os.path.join(root, "*", "image.mha"))):
-            found.setdefault(os.path.basename(os.path.dirname(d)), os.path.dirname(d))
-    return {k: v for k, v in found.items() if not selection or k in selection}
-
-
-def seeds(path):
-    return ps.TableToPoints(Input=ps.CSVReader(FileName=[path]), XColumn="x", YColumn="y", ZColumn="z")
-
-
-def dice(a, b):
-    a, b = a.astype(bool), b.astype(bool)
-    return 2.0 * (a & b).sum() / max(1, a.sum() + b.sum())
+ROOT = fm.ROOT
 
 
 def main():
@@ -48,10 +31,9 @@ def main():
     ap.add_argument("--cases", default="")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "benchmark"))
     args = ap.parse_args()
-    plugin = glob.glob(os.path.join(ROOT, "build", "**", "FeatureMesh.so"), recursive=True)[0]
-    LoadPlugin(plugin, ns=globals())
+    fm.load_plugin(ns=globals())
     rows = []
-    for name, d in cases([c for c in args.cases.split(",") if c]).items():
+    for name, d in fm.cases([c for c in args.cases.split(",") if c]).items():
         image = ps.OpenDataFile(os.path.join(d, "image.mha"))
         image.UpdatePipeline()
         scalars = image.PointData.keys()[0]

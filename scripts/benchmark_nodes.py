@@ -6,36 +6,28 @@ wall time, with the node count, for each case (bundled Data/ first, then ../shar
 Issue 2 targets on a 2-core machine: 512x512 <= 15 ms, BraTS (240x240x155) <= 600 ms.
 """
 import argparse
-import glob
 import os
 import statistics
+import sys
 import time
 
 from paraview import servermanager as sm
 from paraview.simple import *  # noqa: F401,F403
 import paraview.simple as ps
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
-
-
-def find_case(name):
-    for root in (os.path.join(ROOT, "Data"), os.path.join(ROOT, "..", "shared", "data", "cases")):
-        path = os.path.join(root, name, "image.mha")
-        if os.path.exists(path):
-            return path
-    return None
-
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+import featuremesh as fm  # noqa: E402
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--runs", type=int, default=15)
     ap.add_argument("--cases", default="nuclei-dsb2018,brain-tumour-brats-0005")
     args = ap.parse_args()
-    LoadPlugin(glob.glob(os.path.join(ROOT, "build", "**", "FeatureMesh.so"), recursive=True)[0], ns=globals())
+    fm.load_plugin(ns=globals())
     rows, steps = [], []
     for name in args.cases.split(","):
-        path = find_case(name)
+        folder = fm.case_dir(name)
+        path = folder and os.path.join(folder, "image.mha")
         if not path:
             print("note: case %s not found, skipped" % name)
             continue

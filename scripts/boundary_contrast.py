@@ -11,8 +11,8 @@ must be >= 1.5 (issue 2); where every measure is below 1, no recipe that places 
 features alone can get there.
 """
 import argparse
-import glob
 import os
+import sys
 
 import numpy as np
 from scipy import ndimage
@@ -23,16 +23,8 @@ from vtkmodules.util.numpy_support import numpy_to_vtk as n2v
 from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 from vtkmodules.vtkCommonDataModel import vtkImageData
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
-
-
-def case_dir(name):
-    for root in (os.path.join(ROOT, "Data"), os.path.join(ROOT, "..", "shared", "data", "cases")):
-        if os.path.exists(os.path.join(root, name, "truth.mha")):
-            return os.path.join(root, name)
-    return None
-
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+import featuremesh as fm  # noqa: E402
 
 def largest_abs_hessian_eigenvalue(a, sigma):
     axes = range(a.ndim)
@@ -52,14 +44,14 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--cases", default="nuclei-dsb2018,liver-ct-totalseg")
     args = ap.parse_args()
-    LoadPlugin(glob.glob(os.path.join(ROOT, "build", "**", "FeatureMesh.so"), recursive=True)[0], ns=globals())
+    fm.load_plugin(ns=globals())
     header = ["case", "|grad| s=0.7", "|grad| s=1.5", "|grad| s=3", "top-10% |grad|", "|Hessian| s=2", "nodes",
               "nodes, reference boundary as edge map"]
     print("near / far ratios (near: <= 3 voxels from the reference boundary, far: > 10)")
     print("| " + " | ".join(header) + " |")
     print("|" + "---|" * len(header))
     for name in args.cases.split(","):
-        d = case_dir(name)
+        d = fm.case_dir(name)
         if not d:
             print("note: case %s not found, skipped" % name)
             continue

@@ -6,9 +6,9 @@ Seeds: CSV files with columns x,y,z in world coordinates, or "x,y,z;x,y,z" on th
 Writes DIR/<name>_mesh.vtu, _boundary.vtp, _labels.vti, _report.json and _view.png.
 """
 import argparse
-import glob
 import json
 import os
+import sys
 import time
 
 from paraview import servermanager as sm
@@ -17,22 +17,8 @@ import paraview.simple as ps
 from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 from vtkmodules.vtkIOXML import vtkXMLImageDataWriter, vtkXMLPolyDataWriter, vtkXMLUnstructuredGridWriter
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-
-
-def find_plugin():
-    hits = glob.glob(os.path.join(HERE, "..", "build", "**", "FeatureMesh.so"), recursive=True)
-    if not hits:
-        raise SystemExit("FeatureMesh.so not found: build the project or pass --plugin")
-    return hits[0]
-
-
-def seed_source(arg):
-    if os.path.isfile(arg):
-        return ps.TableToPoints(Input=ps.CSVReader(FileName=[arg]), XColumn="x", YColumn="y", ZColumn="z")
-    coords = [float(v) for p in arg.split(";") for v in p.split(",")]
-    return ps.PolyPointSource(Points=coords)
-
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+import featuremesh as fm  # noqa: E402
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -43,7 +29,7 @@ def main():
     ap.add_argument("--out", default="out")
     ap.add_argument("--plugin")
     args = ap.parse_args()
-    LoadPlugin(args.plugin or find_plugin(), ns=globals())
+    fm.load_plugin(args.plugin, ns=globals())
     os.makedirs(args.out, exist_ok=True)
     name = os.path.basename(os.path.dirname(os.path.abspath(args.image))) if os.path.basename(args.image).startswith("image.") else os.path.splitext(os.path.basename(args.image))[0]
     base = os.path.join(args.out, name)
@@ -53,7 +39,7 @@ def main():
     image = ps.OpenDataFile(args.image)
     image.UpdatePipeline()
     times["read"] = time.perf_counter() - t
-    so, sb = seed_source(args.object_seeds), seed_source(args.background_seeds)
+    so, sb = fm.seeds(args.object_seeds), fm.seeds(args.background_seeds)
     so.UpdatePipeline()
     sb.UpdatePipeline()
     nodes = FeatureNodes(Input=image)
@@ -84,7 +70,7 @@ def main():
         truth = ps.OpenDataFile(args.truth)
         T = v2n(sm.Fetch(truth).GetPointData().GetScalars()).astype(bool)
         L = v2n(labels.GetPointData().GetScalars()).astype(bool)
-        report["dice"] = float(2 * (T & L).sum() / max(1, T.sum() + L.sum()))
+        report["dice"] = float(fm.dice(L, T))
     with open(base + "_report.json", "w") as f:
         json.dump(report, f, indent=2)
 

@@ -1,4 +1,4 @@
-"""Shared helpers of the pvpython tests: plugin loading, data lookup, seeds, Dice, hashing."""
+"""Helpers of the pvpython tests on top of the featuremesh package: skip codes, checks, hashing."""
 import atexit
 import hashlib
 import os
@@ -6,29 +6,26 @@ import shutil
 import subprocess
 import sys
 
-from paraview import servermanager as sm
-from paraview.simple import *  # noqa: F401,F403
-from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
+import featuremesh as fm  # noqa: E402
+from featuremesh import dice, fetch, np, seeds, v2n  # noqa: E402,F401
 
-import numpy as np
-
-PLUGIN = os.environ["FEATUREMESH_PLUGIN"]
-DATA = os.environ["FEATUREMESH_DATA"]
-SHARED = os.environ.get("FEATUREMESH_SHARED_DATA", "")
-LoadPlugin(PLUGIN, ns=globals())
+from paraview.simple import *  # noqa: E402,F401,F403
 import paraview.simple as ps  # noqa: E402
 
+fm.load_plugin(ns=globals())
+
+PLUGIN, DATA, SHARED = fm.find_plugin(), fm.DATA, fm.SHARED
 SKIP = 77
 
 
 def case_dir(case):
     """Bundled case folder, else the shared one; exits with the skip code when neither exists."""
-    for root in (DATA, os.path.join(SHARED, "cases")):
-        d = os.path.join(root, case)
-        if os.path.isfile(os.path.join(d, "image.mha")):
-            return d
-    print("SKIP: case %s not found (bundled Data/ or ../shared/data/cases)" % case)
-    sys.exit(SKIP)
+    d = fm.case_dir(case)
+    if d is None:
+        print("SKIP: case %s not found (bundled Data/ or ../shared/data/cases)" % case)
+        sys.exit(SKIP)
+    return d
 
 
 def open_case(case):
@@ -39,26 +36,11 @@ def open_case(case):
     return d, image, truth
 
 
-def seeds(path):
-    reader = ps.CSVReader(FileName=[path])
-    return ps.TableToPoints(Input=reader, XColumn="x", YColumn="y", ZColumn="z")
-
-
 def array(data, name=None, cells=False):
     attrs = data.GetCellData() if cells else data.GetPointData()
     a = attrs.GetArray(name) if name else attrs.GetScalars()
     assert a is not None, "missing array %s" % name
     return v2n(a)
-
-
-def fetch(proxy, port=0):
-    return sm.Fetch(proxy, idx=port)
-
-
-def dice(a, b):
-    a = np.asarray(a).astype(bool)
-    b = np.asarray(b).astype(bool)
-    return 2.0 * (a & b).sum() / max(1, a.sum() + b.sum())
 
 
 def digest(*arrays):
