@@ -2,7 +2,11 @@
 #include "BoykovJolly.h"
 #include "DelaunayMesh.h"
 #include "ElementRasterizer.h"
+#include "Canny.h"
+#include "EdgeSampling.h"
 #include "FeatureNodes.h"
+#include "Halftoning.h"
+#include "ImageFilters.h"
 #include "SimplexMesh.h"
 #include "SuperVoxelCut.h"
 

@@ -1,0 +1,31 @@
+// Image filters on float volumes in index space (x fastest): Gaussian smoothing, gradient
+// magnitude, robust maximum, the Hessian feature map. Stages 1, 3 and 5 share them.
+#pragma once
+
+#include "ImageGeometry.h"
+#include "Parallel.h"
+
+#include <cstdint>
+
+namespace featuremesh
+{
+// Separable Gaussian smoothing, sigma in voxels, kernel radius ceil(3 sigma), borders replicated.
+// Own implementation because vtkImageGaussianSmooth measured 0.54 s (SMP) to 1.16 s (threads) for
+// sigma 0.7 on a 240x240x155 float volume, against a 0.6 s budget for the whole stage.
+void GaussianSmooth(const float* in, float* out, const ImageGeometry& grid, double sigma, const ParallelFor& parallel);
+
+// Gradient magnitude by central differences (one-sided on the border), in voxel units.
+void GradientMagnitude(const float* image, const ImageGeometry& grid, float* magnitude, const ParallelFor& parallel);
+
+// Value below which `percentile` % of the values lie (a 4096-bin histogram over [0, max]).
+double RobustMaximum(const float* values, std::int64_t n, double percentile, const ParallelFor& parallel);
+
+// max |eigenvalue| of the symmetric 3x3 matrix [a11 a12 a13; a12 a22 a23; a13 a23 a33], to about
+// 1e-6 of the matrix norm.
+float LargestAbsEigenvalue(float a11, float a22, float a33, float a12, float a13, float a23);
+
+// rho = (max_i |mu_i| / A)^gamma from the Hessian's eigenvalues, A a robust maximum; clipped to 1.
+// Written into a caller's buffer of n floats.
+void HessianFeatureMap(const float* smoothed, const ImageGeometry& grid, double gamma, double percentile,
+  const ParallelFor& parallel, float* rho, double* featureMaximum = nullptr);
+} // namespace featuremesh
