@@ -620,3 +620,322 @@ TEST(SimplexMesh, LabelBoundaryIsClosedAndOutward)
     EXPECT_NEAR(enclosed, labelled, 1e-9 * labelled) << (mirrored ? "mirrored" : "identity");
   }
 }
+
+//------------------------------------------------------------------------------------------------
+// Fast paths against naive references: each kernel's fast path claims the same sums in the same
+// order as the plain definition, so the comparisons are exact.
+namespace
+{
+// Small chunks in reverse order: stands in for threads, and for any split of the loops.
+const ParallelFor Chunked = [](std::int64_t n, std::int64_t, const RangeFunction& body) {
+  for (std::int64_t b = ((n - 1) / 3) * 3; b >= 0; b -= 3)
+    body(b, std::min(n, b + 3));
+};
+
+// Noise with flat rows, a flat slab and a plateau: every shortcut of the kernels gets used.
+std::vector<float> TestVolume(const ImageGeometry& g, unsigned seed)
+{
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.f, 100.f);
+  std::vector<float> f(g.Size());
+  for (int k = 0; k < g.Dims[2]; ++k)
+    for (int j = 0; j < g.Dims[1]; ++j)
+      for (int i = 0; i < g.Dims[0]; ++i)
+      {
+        float v = u(rng);
+        if (j % 5 == 0 || (g.Dims[2] > 2 && k == 1))
+          v = 42.f; // flat rows, a flat slice
+        else if (std::hypot(i - g.Dims[0] / 2.0, j - g.Dims[1] / 2.0) < 4.0)
+          v = 90.f; // a plateau: ties for non-maximum suppression
+        f[g.Index(i, j, k)] = v;
+      }
+  return f;
+}
+
+std::vector<ImageGeometry> TestGrids()
+{
+  ImageGeometry a, b, c;
+  a.Dims = { { 37, 29, 1 } };
+  b.Dims = { { 23, 19, 17 } };
+  c.Dims = { { 2, 9, 5 } }; // rows too short for an interior
+  return { a, b, c };
+}
+
+int Clamp(int v, int n)
+{
+  return std::min(n - 1, std::max(0, v));
+}
+
+std::vector<float> NaiveGaussian(const std::vector<float>& in, const ImageGeometry& g, double sigma)
+{
+  const int r = std::max(1, static_cast<int>(std::ceil(3.0 * sigma)));
+  std::vector<float> w(2 * r + 1);
+  double sum = 0.0;
+  for (int t = -r; t <= r; ++t)
+    sum += w[t + r] = static_cast<float>(std::exp(-0.5 * t * t / (sigma * sigma)));
+  for (float& v : w)
+    v = static_cast<float>(v / sum);
+  std::vector<float> cur = in, next(in.size());
+  for (int axis = 0; axis < (g.Is2D() ? 2 : 3); ++axis)
+  {
+    for (int k = 0; k < g.Dims[2]; ++k)
+      for (int j = 0; j < g.Dims[1]; ++j)
+        for (int i = 0; i < g.Dims[0]; ++i)
+        {
+          float acc = 0.f;
+          for (int t = -r; t <= r; ++t)
+          {
+            int ijk[3] = { i, j, k };
+            ijk[axis] = Clamp(ijk[axis] + t, g.Dims[axis]);
+            acc += w[t + r] * cur[g.Index(ijk[0], ijk[1], ijk[2])];
+          }
+          next[g.Index(i, j, k)] = acc;
+        }
+    std::swap(cur, next);
+  }
+  return cur;
+}
+
+// Central differences, one-sided on the border, zero along a one-voxel axis.
+std::array<float, 3> NaiveGradient(const std::vector<float>& f, const ImageGeometry& g, int i, int j, int k)
+{
+  std::array<float, 3> d{};
+  const int c[3] = { i, j, k };
+  for (int a = 0; a < 3; ++a)
+  {
+    if (g.Dims[a] < 2)
+      continue;
+    int lo[3] = { i, j, k }, hi[3] = { i, j, k };
+    lo[a] = std::max(0, c[a] - 1);
+    hi[a] = std::min(g.Dims[a] - 1, c[a] + 1);
+    const float diff = f[g.Index(hi[0], hi[1], hi[2])] - f[g.Index(lo[0], lo[1], lo[2])];
+    d[a] = hi[a] - lo[a] == 2 ? 0.5f * diff : diff;
+  }
+  return d;
+}
+} // namespace
+
+TEST(Kernels, GaussianMatchesTheSeparableDefinition)
+{
+  for (const ImageGeometry& g : TestGrids())
+    for (double sigma : { 0.7, 2.0 })
+    {
+      const std::vector<float> f = TestVolume(g, 11);
+      std::vector<float> fast(f.size());
+      GaussianSmooth(f.data(), fast.data(), g, sigma, Chunked);
+      EXPECT_EQ(fast, NaiveGaussian(f, g, sigma)) << g.Dims[0] << "x" << g.Dims[1] << "x" << g.Dims[2] << " sigma " << sigma;
+    }
+}
+
+TEST(Kernels, GradientMagnitudeInteriorMatchesBorderDefinition)
+{
+  for (const ImageGeometry& g : TestGrids())
+  {
+    const std::vector<float> f = TestVolume(g, 12);
+    std::vector<float> fast(f.size());
+    GradientMagnitude(f.data(), g, fast.data(), Chunked);
+    for (int k = 0; k < g.Dims[2]; ++k)
+      for (int j = 0; j < g.Dims[1]; ++j)
+        for (int i = 0; i < g.Dims[0]; ++i)
+        {
+          const auto d = NaiveGradient(f, g, i, j, k);
+          ASSERT_EQ(fast[g.Index(i, j, k)], std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])) << i << "," << j << "," << k;
+        }
+  }
+}
+
+TEST(Kernels, CannyMatchesPlainSuppressionAndFloodFill)
+{
+  for (const ImageGeometry& g : TestGrids())
+  {
+    std::vector<float> f(g.Size());
+    GaussianSmooth(TestVolume(g, 13).data(), f.data(), g, 0.7, SerialFor());
+    const double low = 0.1, high = 0.6, percentile = 99.0;
+    double gmax = 0.0;
+    const std::vector<std::uint8_t> fast = CannyEdges(f.data(), g, low, high, percentile, Chunked, &gmax);
+    // Plain: magnitude, suppression with bounds checks everywhere, 8-/26-connected flood fill.
+    std::vector<float> mag(g.Size());
+    for (int k = 0; k < g.Dims[2]; ++k)
+      for (int j = 0; j < g.Dims[1]; ++j)
+        for (int i = 0; i < g.Dims[0]; ++i)
+        {
+          const auto d = NaiveGradient(f, g, i, j, k);
+          mag[g.Index(i, j, k)] = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        }
+    ASSERT_EQ(gmax, RobustMaximum(mag.data(), g.Size(), percentile, SerialFor()));
+    const float lowV = static_cast<float>(low * gmax), highV = static_cast<float>(high * gmax);
+    std::vector<std::uint8_t> state(g.Size(), 0);
+    for (int k = 0; k < g.Dims[2]; ++k)
+      for (int j = 0; j < g.Dims[1]; ++j)
+        for (int i = 0; i < g.Dims[0]; ++i)
+        {
+          const float m = mag[g.Index(i, j, k)];
+          if (m < lowV || m <= 0.f)
+            continue;
+          const auto d = NaiveGradient(f, g, i, j, k);
+          const float cut = 0.41421356f * std::max(std::fabs(d[0]), std::max(std::fabs(d[1]), std::fabs(d[2])));
+          int s[3];
+          for (int a = 0; a < 3; ++a)
+            s[a] = std::fabs(d[a]) >= cut ? (d[a] > 0.f) - (d[a] < 0.f) : 0;
+          const float ahead = g.Contains(i + s[0], j + s[1], k + s[2]) ? mag[g.Index(i + s[0], j + s[1], k + s[2])] : 0.f;
+          const float behind = g.Contains(i - s[0], j - s[1], k - s[2]) ? mag[g.Index(i - s[0], j - s[1], k - s[2])] : 0.f;
+          if (m > ahead && m >= behind)
+            state[g.Index(i, j, k)] = m >= highV ? 2 : 1;
+        }
+    std::vector<std::uint8_t> edges(g.Size(), 0);
+    std::vector<std::int64_t> queue;
+    for (std::int64_t v = 0; v < g.Size(); ++v)
+      if (state[v] == 2)
+      {
+        edges[v] = 1;
+        queue.push_back(v);
+      }
+    while (!queue.empty())
+    {
+      const std::int64_t v = queue.back();
+      queue.pop_back();
+      const int k = static_cast<int>(v / g.SliceStride()), j = static_cast<int>(v / g.Dims[0] % g.Dims[1]),
+                i = static_cast<int>(v % g.Dims[0]);
+      for (int dk = -1; dk <= 1; ++dk)
+        for (int dj = -1; dj <= 1; ++dj)
+          for (int di = -1; di <= 1; ++di)
+            if ((!g.Is2D() || dk == 0) && g.Contains(i + di, j + dj, k + dk))
+            {
+              const std::int64_t q = g.Index(i + di, j + dj, k + dk);
+              if (state[q] && !edges[q])
+              {
+                edges[q] = 1;
+                queue.push_back(q);
+              }
+            }
+    }
+    EXPECT_EQ(fast, edges) << g.Dims[0] << "x" << g.Dims[1] << "x" << g.Dims[2];
+    EXPECT_GT(std::count(edges.begin(), edges.end(), 1), 3);
+  }
+}
+
+TEST(Kernels, PCARadiiFromTableMatchPlainMoments)
+{
+  for (const ImageGeometry& g : TestGrids())
+    for (int window : { 0, 9, 13, 15 }) // 0 = default (11 in 2D, 5 in 3D); 15 takes the plain path
+    {
+      std::mt19937 rng(14);
+      std::vector<std::uint8_t> edgeMap(g.Size(), 0);
+      std::vector<std::int64_t> points;
+      for (std::int64_t v = 0; v < g.Size(); ++v)
+        if (rng() % 10 < 3)
+        {
+          edgeMap[v] = 1;
+          points.push_back(v);
+        }
+      FeatureNodeParameters p;
+      p.CovarianceNeighbourhood = window;
+      const std::vector<std::uint8_t> fast = EdgeSampleRadii(points, edgeMap, g, p, Chunked);
+      const int w = window > 0 ? window : (g.Is2D() ? 11 : 5), h = w / 2;
+      const auto& radii = g.Is2D() ? p.Radii2D : p.Radii3D;
+      for (size_t t = 0; t < points.size(); ++t)
+      {
+        const std::int64_t v = points[t];
+        const int k = static_cast<int>(v / g.SliceStride()), j = static_cast<int>(v / g.Dims[0] % g.Dims[1]),
+                  i = static_cast<int>(v % g.Dims[0]);
+        // Plain integer moments of the edge points in the box, relative to the centre.
+        std::int64_t c = 0, s[3] = { 0, 0, 0 }, q[3][3] = {};
+        for (int dk = -h; dk <= h; ++dk)
+          for (int dj = -h; dj <= h; ++dj)
+            for (int di = -h; di <= h; ++di)
+              if (g.Contains(i + di, j + dj, k + dk) && edgeMap[g.Index(i + di, j + dj, k + dk)])
+              {
+                const std::int64_t x[3] = { di, dj, dk };
+                ++c;
+                for (int a = 0; a < 3; ++a)
+                {
+                  s[a] += x[a];
+                  for (int b = 0; b < 3; ++b)
+                    q[a][b] += x[a] * x[b];
+                }
+              }
+        int cls = 2;
+        if (c > g.Dimension())
+        {
+          const double n = static_cast<double>(c);
+          Eigen::Matrix3d cov;
+          for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b)
+              cov(a, b) = static_cast<double>(q[a][b]) / n - double(s[a]) * double(s[b]) / (n * n);
+          double ratio = 1.0;
+          if (g.Is2D())
+          {
+            Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;
+            es.computeDirect(cov.topLeftCorner<2, 2>(), Eigen::EigenvaluesOnly);
+            const double l1 = es.eigenvalues()(1), l2 = std::max(0.0, es.eigenvalues()(0));
+            ratio = l1 > 1e-12 ? l2 / l1 : 1.0;
+          }
+          else
+          {
+            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+            es.computeDirect(cov, Eigen::EigenvaluesOnly);
+            const double l1 = es.eigenvalues()(2), l3 = std::max(0.0, es.eigenvalues()(0));
+            ratio = l1 > 1e-12 ? l3 / l1 : 1.0;
+          }
+          cls = ratio < p.StraightRatio ? 0 : (ratio < p.CurvedRatio ? 1 : 2);
+        }
+        ASSERT_EQ(fast[t], radii[cls]) << "window " << w << " point " << i << "," << j << "," << k;
+      }
+    }
+}
+
+TEST(Kernels, HalftoneMatchesErrorDiffusionOnTheWholeVolume)
+{
+  for (const ImageGeometry& g : TestGrids())
+    for (double q : { 0.3, 0.5 })
+    {
+      std::mt19937 rng(15);
+      std::uniform_real_distribution<float> u(0.f, 1.f);
+      std::vector<float> rho(g.Size());
+      for (std::int64_t v = 0; v < g.Size(); ++v)
+        rho[v] = v % 7 == 0 ? 1.f : (v % 11 < 4 ? 0.f : u(rng) * u(rng)); // saturated, empty, varied
+      const std::vector<std::int64_t> fast = Halftone(rho.data(), g, q);
+      // The definition on a volume-sized error buffer with bounds checks: classic Floyd-Steinberg
+      // weights (halved in 3D, the other half to the next slice: centre 6/16, 4-neighbours 2.5/16),
+      // a dot worth 2q, error clamped to +-2q, negligible error (< 1e-6) dropped.
+      const float threshold = static_cast<float>(q), dot = static_cast<float>(2.0 * q);
+      const float w = g.Is2D() ? 1.f : 0.5f;
+      std::vector<float> e(g.Size(), 0.f);
+      std::vector<std::int64_t> dots;
+      auto push = [&](int i, int j, int k, float amount) {
+        if (g.Contains(i, j, k))
+          e[g.Index(i, j, k)] += amount;
+      };
+      for (int k = 0; k < g.Dims[2]; ++k)
+        for (int j = 0; j < g.Dims[1]; ++j)
+          for (int i = 0; i < g.Dims[0]; ++i)
+          {
+            const std::int64_t v = g.Index(i, j, k);
+            const float value = rho[v] + e[v];
+            if (std::fabs(value) < 1e-6f)
+              continue;
+            float err = value;
+            if (value >= threshold)
+            {
+              dots.push_back(v);
+              err = value - dot;
+            }
+            err = std::max(-dot, std::min(dot, err));
+            push(i + 1, j, k, err * (w * (7.f / 16.f)));
+            push(i - 1, j + 1, k, err * (w * (3.f / 16.f)));
+            push(i, j + 1, k, err * (w * (5.f / 16.f)));
+            push(i + 1, j + 1, k, err * (w * (1.f / 16.f)));
+            if (!g.Is2D())
+            {
+              const float half = 0.5f * err, side = half * (2.5f / 16.f);
+              push(i, j, k + 1, half * (6.f / 16.f));
+              push(i - 1, j, k + 1, side);
+              push(i + 1, j, k + 1, side);
+              push(i, j - 1, k + 1, side);
+              push(i, j + 1, k + 1, side);
+            }
+          }
+      EXPECT_EQ(fast, dots) << g.Dims[0] << "x" << g.Dims[1] << "x" << g.Dims[2] << " q " << q;
+      EXPECT_GT(dots.size(), 10u);
+    }
+}
