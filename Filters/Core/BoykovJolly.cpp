@@ -116,9 +116,9 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par)
     return r;
   }
   r.Bins = par.Bins > 0 ? par.Bins : 64;
-  const bool exact = pr.PixelValue && pr.PixelOwner;
-  const double* rangeData = exact ? pr.PixelValue : pr.Value.data();
-  const std::int64_t rangeCount = exact ? pr.PixelTotal : n;
+  const bool exact = pr.VoxelValue && pr.VoxelOwner;
+  const double* rangeData = exact ? pr.VoxelValue : pr.Value.data();
+  const std::int64_t rangeCount = exact ? pr.VoxelTotal : n;
   double low = Percentile(rangeData, rangeCount, 0.5), high = Percentile(rangeData, rangeCount, 99.5);
   for (double v : pr.ObjectSamples)
   {
@@ -178,12 +178,12 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par)
   std::vector<double> regionObject(n), regionBackground(n);
   if (exact)
   {
-    for (std::int64_t v = 0; v < pr.PixelTotal; ++v)
+    for (std::int64_t v = 0; v < pr.VoxelTotal; ++v)
     {
-      const std::int64_t p = pr.PixelOwner[v];
+      const std::int64_t p = pr.VoxelOwner[v];
       if (p >= 0 && p < n)
       {
-        const int b = bin(pr.PixelValue[v]);
+        const int b = bin(pr.VoxelValue[v]);
         regionObject[p] += costObject[b];
         regionBackground[p] += costBackground[b];
       }

@@ -7,7 +7,7 @@
 // Pr(I | object/background) is a kernel density estimate of the seed samples on a histogram over a
 // robust intensity range (0.5 to 99.5 percentiles of the node intensities, or of the voxel values
 // with the voxel region term), mixed with 1 % of a uniform density so that no intensity is impossible.
-// With the voxel region term (PixelValue/PixelOwner set) a super-voxel's region cost is the sum of
+// With the voxel region term (VoxelValue/VoxelOwner set) a super-voxel's region cost is the sum of
 // its voxels' costs, so for region terms the super-voxel cut is the voxel cut restricted to labellings
 // that are constant on elements.
 #pragma once
@@ -38,12 +38,12 @@ struct CutProblem
   std::vector<std::uint8_t> Hard; // 0 free, 1 object seed, 2 background seed
   std::vector<double> ObjectSamples, ObjectWeights, BackgroundSamples, BackgroundWeights;
   // Optional exact region term for super-voxels (not owned; both set or both null): node p's region
-  // cost becomes the sum over its voxels v (PixelOwner[v] == p, -1 = none) of -ln Pr(PixelValue[v] | L)
+  // cost becomes the sum over its voxels v (VoxelOwner[v] == p, -1 = none) of -ln Pr(VoxelValue[v] | L)
   // instead of Size_p * -ln Pr(Value_p | L). A mixed element then costs what its voxels would cost
   // in the voxel cut, rather than what its mean would.
-  const double* PixelValue = nullptr;
-  const std::int64_t* PixelOwner = nullptr;
-  std::int64_t PixelTotal = 0;
+  const double* VoxelValue = nullptr;
+  const std::int64_t* VoxelOwner = nullptr;
+  std::int64_t VoxelTotal = 0;
 };
 
 struct CutResult

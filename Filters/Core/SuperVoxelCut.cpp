@@ -100,9 +100,9 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<dou
     }
     if (parameters.VoxelRegionTerm)
     {
-      pr.PixelValue = voxelValues;
-      pr.PixelOwner = owner.data();
-      pr.PixelTotal = n;
+      pr.VoxelValue = voxelValues;
+      pr.VoxelOwner = owner.data();
+      pr.VoxelTotal = n;
     }
   }
   else

@@ -411,9 +411,9 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   pr.ObjectSamples = { 10.0, 11.0, 12.4 };
   pr.BackgroundSamples = { 0.0, 1.2, 2.4 };
   const CutResult byMean = BoykovJollyCut(pr, BoykovJollyParameters());
-  pr.PixelValue = pixels.data();
-  pr.PixelOwner = owner.data();
-  pr.PixelTotal = static_cast<std::int64_t>(pixels.size());
+  pr.VoxelValue = pixels.data();
+  pr.VoxelOwner = owner.data();
+  pr.VoxelTotal = static_cast<std::int64_t>(pixels.size());
   const CutResult byVoxel = BoykovJollyCut(pr, BoykovJollyParameters());
   ASSERT_TRUE(byMean.Error.empty() && byVoxel.Error.empty());
   EXPECT_EQ(byMean.Label, byVoxel.Label);
@@ -432,9 +432,9 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   const std::vector<std::int64_t> o = { 0, 1, 2, 2, 2, 2 };
   two.ObjectSamples = { 10.0, 9.0, 11.0 };
   two.BackgroundSamples = { 0.0, 1.0, -1.0 };
-  two.PixelValue = v.data();
-  two.PixelOwner = o.data();
-  two.PixelTotal = 6;
+  two.VoxelValue = v.data();
+  two.VoxelOwner = o.data();
+  two.VoxelTotal = 6;
   const CutResult exact = BoykovJollyCut(two, BoykovJollyParameters());
   ASSERT_TRUE(exact.Error.empty());
   EXPECT_EQ(exact.Label[2], 1);
