@@ -82,12 +82,12 @@ int vtkDelaunayImageMesh::RequestData(
       return 0;
     }
     std::vector<double> values;
-    vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
+    const bool valuesOk = ChosenValues(image, this->GetInputArrayInformation(0), values, error, warning);
     if (!warning.empty())
     {
       vtkWarningMacro("Delaunay Image Mesh: " << warning);
     }
-    if (!array || !ToDouble(array, values, error))
+    if (!valuesOk)
     {
       vtkErrorMacro("Delaunay Image Mesh: " << error);
       return 0;

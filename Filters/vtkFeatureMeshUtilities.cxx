@@ -438,6 +438,13 @@ vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::s
   return array;
 }
 
+bool ChosenValues(vtkImageData* image, vtkInformation* arrayInfo, std::vector<double>& values, std::string& error,
+  std::string& warning)
+{
+  vtkDataArray* array = ChosenArray(image, arrayInfo, error, warning);
+  return array && ToDouble(array, values, error);
+}
+
 void AddFieldValue(vtkDataObject* object, const char* name, double value)
 {
   vtkNew<vtkDoubleArray> a;

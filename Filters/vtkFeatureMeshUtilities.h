@@ -91,6 +91,11 @@ const float* FloatValues(vtkDataArray* array, std::vector<float>& storage, std::
 // a warning sentence; null with an error sentence when there are none.
 vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::string& error, std::string& warning);
 
+// The values of the chosen array (ChosenArray) as doubles; false with `error` set when unusable.
+// `warning` is set when the chosen name fell back to the active scalars.
+bool ChosenValues(vtkImageData* image, vtkInformation* arrayInfo, std::vector<double>& values, std::string& error,
+  std::string& warning);
+
 // Adds a one-value double array `name` to the object's field data (summaries, timings).
 void AddFieldValue(vtkDataObject* object, const char* name, double value);
 } // namespace featuremesh

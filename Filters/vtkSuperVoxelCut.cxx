@@ -152,12 +152,12 @@ int vtkSuperVoxelCut::RequestData(
     std::vector<double> values;
     if (image)
     {
-      vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
+      const bool valuesOk = ChosenValues(image, this->GetInputArrayInformation(0), values, error, warning);
       if (!warning.empty())
       {
         vtkWarningMacro("Super-Voxel Cut: " << warning);
       }
-      if (!array || !ToDouble(array, values, error))
+      if (!valuesOk)
       {
         return fail(error);
       }

@@ -92,12 +92,12 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     return fail(error);
   }
   std::vector<double> values;
-  vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
+  const bool valuesOk = ChosenValues(image, this->GetInputArrayInformation(0), values, error, warning);
   if (!warning.empty())
   {
     vtkWarningMacro("Voxel Cut: " << warning);
   }
-  if (!array || !ToDouble(array, values, error))
+  if (!valuesOk)
   {
     return fail(error);
   }

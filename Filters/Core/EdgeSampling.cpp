@@ -24,6 +24,43 @@ inline std::uint64_t PackBytes(const std::uint8_t* p)
 }
 } // namespace
 
+std::uint8_t SamplingRadius(std::int64_t count, const std::int64_t moments[9], int dimension, const FeatureNodeParameters& p)
+{
+  const std::int64_t s0 = moments[0], s1 = moments[1], s2 = moments[2], q0 = moments[3], q1 = moments[4],
+                     q2 = moments[5], q3 = moments[6], q4 = moments[7], q5 = moments[8];
+  const std::array<int, 3>& radii = dimension == 2 ? p.Radii2D : p.Radii3D;
+  int cls = 2; // curved, corner or speck: densest sampling
+  if (count > dimension)
+  {
+    const double c = static_cast<double>(count);
+    const double m0 = static_cast<double>(s0), m1 = static_cast<double>(s1), m2 = static_cast<double>(s2);
+    Eigen::Matrix3d cov;
+    cov(0, 0) = static_cast<double>(q0) / c - m0 * m0 / (c * c);
+    cov(1, 1) = static_cast<double>(q1) / c - m1 * m1 / (c * c);
+    cov(2, 2) = static_cast<double>(q2) / c - m2 * m2 / (c * c);
+    cov(0, 1) = cov(1, 0) = static_cast<double>(q3) / c - m0 * m1 / (c * c);
+    cov(0, 2) = cov(2, 0) = static_cast<double>(q4) / c - m0 * m2 / (c * c);
+    cov(1, 2) = cov(2, 1) = static_cast<double>(q5) / c - m1 * m2 / (c * c);
+    double ratio = 1.0;
+    if (dimension == 2)
+    {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;
+      es.computeDirect(cov.topLeftCorner<2, 2>(), Eigen::EigenvaluesOnly);
+      const double l1 = es.eigenvalues()(1), l2 = std::max(0.0, es.eigenvalues()(0));
+      ratio = l1 > 1e-12 ? l2 / l1 : 1.0;
+    }
+    else
+    {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+      es.computeDirect(cov, Eigen::EigenvaluesOnly);
+      const double l1 = es.eigenvalues()(2), l3 = std::max(0.0, es.eigenvalues()(0));
+      ratio = l1 > 1e-12 ? l3 / l1 : 1.0;
+    }
+    cls = ratio < p.StraightRatio ? 0 : (ratio < p.CurvedRatio ? 1 : 2);
+  }
+  return static_cast<std::uint8_t>(radii[cls]);
+}
+
 std::vector<std::uint8_t> EdgeSampleRadii(const std::vector<std::int64_t>& pts,
   const std::vector<std::uint8_t>& edgeMap, const ImageGeometry& g, const FeatureNodeParameters& p,
   const ParallelFor& parallel)
@@ -32,7 +69,6 @@ std::vector<std::uint8_t> EdgeSampleRadii(const std::vector<std::int64_t>& pts,
   const int window = p.CovarianceNeighbourhood > 0 ? p.CovarianceNeighbourhood : (is2D ? 11 : 5);
   const int h = window / 2;
   const int width = 2 * h + 1;
-  const std::array<int, 3>& radii = is2D ? p.Radii2D : p.Radii3D;
   // Each row of the box is read as a bit pattern whose count and first and second x-moments come
   // from a table: one lookup per row instead of a branch per voxel. Integer
   // sums, so the moments are exact and identical to a voxel-by-voxel sum.
@@ -138,36 +174,8 @@ std::vector<std::uint8_t> EdgeSampleRadii(const std::vector<std::int64_t>& pts,
         q4 += z * X;
         q5 += z * YC;
       }
-      int cls = 2; // curved, corner or speck: densest sampling
-      if (count > g.Dimension())
-      {
-        const double c = static_cast<double>(count);
-        const double m0 = static_cast<double>(s0), m1 = static_cast<double>(s1), m2 = static_cast<double>(s2);
-        Eigen::Matrix3d cov;
-        cov(0, 0) = static_cast<double>(q0) / c - m0 * m0 / (c * c);
-        cov(1, 1) = static_cast<double>(q1) / c - m1 * m1 / (c * c);
-        cov(2, 2) = static_cast<double>(q2) / c - m2 * m2 / (c * c);
-        cov(0, 1) = cov(1, 0) = static_cast<double>(q3) / c - m0 * m1 / (c * c);
-        cov(0, 2) = cov(2, 0) = static_cast<double>(q4) / c - m0 * m2 / (c * c);
-        cov(1, 2) = cov(2, 1) = static_cast<double>(q5) / c - m1 * m2 / (c * c);
-        double ratio = 1.0;
-        if (is2D)
-        {
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;
-          es.computeDirect(cov.topLeftCorner<2, 2>(), Eigen::EigenvaluesOnly);
-          const double l1 = es.eigenvalues()(1), l2 = std::max(0.0, es.eigenvalues()(0));
-          ratio = l1 > 1e-12 ? l2 / l1 : 1.0;
-        }
-        else
-        {
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
-          es.computeDirect(cov, Eigen::EigenvaluesOnly);
-          const double l1 = es.eigenvalues()(2), l3 = std::max(0.0, es.eigenvalues()(0));
-          ratio = l1 > 1e-12 ? l3 / l1 : 1.0;
-        }
-        cls = ratio < p.StraightRatio ? 0 : (ratio < p.CurvedRatio ? 1 : 2);
-      }
-      result[t] = static_cast<std::uint8_t>(radii[cls]);
+      const std::int64_t moments[9] = { s0, s1, s2, q0, q1, q2, q3, q4, q5 };
+      result[t] = SamplingRadius(count, moments, g.Dimension(), p);
     }
   });
   return result;

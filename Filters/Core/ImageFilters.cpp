@@ -92,14 +92,8 @@ void SmoothAcrossRows(float* o, int nx, const std::vector<float>& w, const float
 }
 } // namespace
 
-void GaussianSmooth(const float* in, float* out, const ImageGeometry& g, double sigma, const ParallelFor& parallel)
+std::vector<float> GaussianKernel(double sigma)
 {
-  const std::int64_t n = g.Size();
-  if (sigma <= 0.0)
-  {
-    std::copy(in, in + n, out);
-    return;
-  }
   const int r = std::max(1, static_cast<int>(std::ceil(3.0 * sigma)));
   std::vector<float> w(2 * r + 1);
   double sum = 0.0;
@@ -111,6 +105,19 @@ void GaussianSmooth(const float* in, float* out, const ImageGeometry& g, double 
   {
     v = static_cast<float>(v / sum);
   }
+  return w;
+}
+
+void GaussianSmooth(const float* in, float* out, const ImageGeometry& g, double sigma, const ParallelFor& parallel)
+{
+  const std::int64_t n = g.Size();
+  if (sigma <= 0.0)
+  {
+    std::copy(in, in + n, out);
+    return;
+  }
+  const std::vector<float> w = GaussianKernel(sigma);
+  const int r = static_cast<int>(w.size() / 2);
   const int nx = g.Dims[0], ny = g.Dims[1], nz = g.Dims[2];
   const std::int64_t slice = g.SliceStride();
   if (nz == 1)

@@ -6,9 +6,13 @@
 #include "Parallel.h"
 
 #include <cstdint>
+#include <vector>
 
 namespace featuremesh
 {
+// Normalised Gaussian taps (sigma > 0, voxels), radius ceil(3 sigma), at least 1.
+std::vector<float> GaussianKernel(double sigma);
+
 // Separable Gaussian smoothing, sigma in voxels, kernel radius ceil(3 sigma), borders replicated.
 // Own implementation because vtkImageGaussianSmooth measured 0.54 s (SMP) to 1.16 s (threads) for
 // sigma 0.7 on a 240x240x155 float volume, against a 0.6 s budget for the whole stage.

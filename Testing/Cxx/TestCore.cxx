@@ -668,13 +668,8 @@ int Clamp(int v, int n)
 
 std::vector<float> NaiveGaussian(const std::vector<float>& in, const ImageGeometry& g, double sigma)
 {
-  const int r = std::max(1, static_cast<int>(std::ceil(3.0 * sigma)));
-  std::vector<float> w(2 * r + 1);
-  double sum = 0.0;
-  for (int t = -r; t <= r; ++t)
-    sum += w[t + r] = static_cast<float>(std::exp(-0.5 * t * t / (sigma * sigma)));
-  for (float& v : w)
-    v = static_cast<float>(v / sum);
+  const std::vector<float> w = GaussianKernel(sigma);
+  const int r = static_cast<int>(w.size() / 2);
   std::vector<float> cur = in, next(in.size());
   for (int axis = 0; axis < (g.Is2D() ? 2 : 3); ++axis)
   {
@@ -832,7 +827,6 @@ TEST(Kernels, PCARadiiFromTableMatchPlainMoments)
       p.CovarianceNeighbourhood = window;
       const std::vector<std::uint8_t> fast = EdgeSampleRadii(points, edgeMap, g, p, Chunked);
       const int w = window > 0 ? window : (g.Is2D() ? 11 : 5), h = w / 2;
-      const auto& radii = g.Is2D() ? p.Radii2D : p.Radii3D;
       for (size_t t = 0; t < points.size(); ++t)
       {
         const std::int64_t v = points[t];
@@ -854,32 +848,8 @@ TEST(Kernels, PCARadiiFromTableMatchPlainMoments)
                     q[a][b] += x[a] * x[b];
                 }
               }
-        int cls = 2;
-        if (c > g.Dimension())
-        {
-          const double n = static_cast<double>(c);
-          Eigen::Matrix3d cov;
-          for (int a = 0; a < 3; ++a)
-            for (int b = 0; b < 3; ++b)
-              cov(a, b) = static_cast<double>(q[a][b]) / n - double(s[a]) * double(s[b]) / (n * n);
-          double ratio = 1.0;
-          if (g.Is2D())
-          {
-            Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es;
-            es.computeDirect(cov.topLeftCorner<2, 2>(), Eigen::EigenvaluesOnly);
-            const double l1 = es.eigenvalues()(1), l2 = std::max(0.0, es.eigenvalues()(0));
-            ratio = l1 > 1e-12 ? l2 / l1 : 1.0;
-          }
-          else
-          {
-            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
-            es.computeDirect(cov, Eigen::EigenvaluesOnly);
-            const double l1 = es.eigenvalues()(2), l3 = std::max(0.0, es.eigenvalues()(0));
-            ratio = l1 > 1e-12 ? l3 / l1 : 1.0;
-          }
-          cls = ratio < p.StraightRatio ? 0 : (ratio < p.CurvedRatio ? 1 : 2);
-        }
-        ASSERT_EQ(fast[t], radii[cls]) << "window " << w << " point " << i << "," << j << "," << k;
+        const std::int64_t moments[9] = { s[0], s[1], s[2], q[0][0], q[1][1], q[2][2], q[0][1], q[0][2], q[1][2] };
+        ASSERT_EQ(fast[t], SamplingRadius(c, moments, g.Dimension(), p)) << "window " << w << " point " << i << "," << j << "," << k;
       }
     }
 }
