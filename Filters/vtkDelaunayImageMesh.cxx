@@ -26,6 +26,12 @@
 
 vtkStandardNewMacro(vtkDelaunayImageMesh);
 
+namespace
+{
+// Beyond this TetGen needs tens of GB and minutes; Feature Nodes places ~0.5 % of the voxels.
+constexpr vtkIdType MaximumNodes = 20000000;
+}
+
 vtkDelaunayImageMesh::vtkDelaunayImageMesh()
 {
   const featuremesh::DelaunayOptions defaults;
@@ -54,7 +60,7 @@ int vtkDelaunayImageMesh::RequestUpdateExtent(
 int vtkDelaunayImageMesh::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return featuremesh::WithThreads([&]() -> int {
+  return featuremesh::RunFilter(this, "Delaunay Image Mesh", [&]() -> int {
     using namespace featuremesh;
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
@@ -63,6 +69,10 @@ int vtkDelaunayImageMesh::RequestData(
     vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
     std::string error, warning;
     ImageGeometry geometry;
+    if (IsEmptyPiece(outputVector, nodes) || IsEmptyPiece(outputVector, image))
+    {
+      return 1;
+    }
     if (!nodes || !image)
     {
       vtkErrorMacro("Delaunay Image Mesh: both the Nodes (point set) and the Image inputs are required.");
@@ -95,10 +105,11 @@ int vtkDelaunayImageMesh::RequestData(
 
     // Nodes in index space (on voxel centres when they came from one).
     std::vector<std::array<double, 3>> index = PointsOf(nodes);
-    vtkIdType outside = 0, offPlane = 0;
+    vtkIdType outside = 0, offPlane = 0, offCentre = 0;
     for (auto& p : index)
     {
       p = geometry.WorldToIndex(p);
+      offCentre += (p[0] != std::round(p[0]) || p[1] != std::round(p[1]) || p[2] != std::round(p[2])) ? 1 : 0;
       bool in = true;
       for (int a = 0; a < 3; ++a)
       {
@@ -116,6 +127,19 @@ int vtkDelaunayImageMesh::RequestData(
     if (outside)
     {
       vtkErrorMacro("Delaunay Image Mesh: " << outside << " of " << nIn << " nodes lie outside the image bounds.");
+      return 0;
+    }
+    if (offCentre)
+    {
+      vtkErrorMacro("Delaunay Image Mesh: " << offCentre << " of " << nIn
+                      << " nodes do not lie on voxel centres; the exact voxel statistics need nodes on voxel "
+                         "centres, as Feature Nodes places them.");
+      return 0;
+    }
+    if (nIn > MaximumNodes)
+    {
+      vtkErrorMacro("Delaunay Image Mesh: " << nIn << " nodes are more than the " << MaximumNodes
+                                            << " this filter meshes; raise the node spacing in Feature Nodes.");
       return 0;
     }
     const std::int64_t duplicates = CountDuplicates(index);
@@ -166,17 +190,23 @@ int vtkDelaunayImageMesh::RequestData(
                     "dihedral angle in [0, 30) degrees.");
       return 0;
     }
-    DelaunayResult delaunay = is2D ? Triangulate2D(frame) : Tetrahedralize(frame, o);
+    // TetGen has no progress or abort of its own: it runs on its own thread, owning its input.
+    DelaunayResult delaunay;
+    if (is2D)
+    {
+      delaunay = Triangulate2D(frame);
+    }
+    else if (!RunWithHeartbeat<DelaunayResult>([frame, o]() { return Tetrahedralize(frame, o); },
+               AlgorithmProgress(this, 0.1, 0.5), delaunay))
+    {
+      return 1;
+    }
     if (!delaunay.Error.empty())
     {
       vtkErrorMacro("Delaunay Image Mesh: " << delaunay.Error);
       return 0;
     }
     const double delaunaySeconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    if (this->GetAbortExecute())
-    {
-      return 1;
-    }
     this->UpdateProgress(0.5);
     // Points the mesher added (TetGen refinement).
     for (size_t i = index.size(); i < delaunay.Points.size(); ++i)
@@ -187,7 +217,12 @@ int vtkDelaunayImageMesh::RequestData(
     t0 = Clock::now();
     const ParallelFor parallel = SMPParallelFor();
     const SimplexMesh mesh(geometry, std::move(index), std::move(delaunay.Cells), delaunay.VerticesPerCell);
-    const ElementStatistics stats = ComputeElementStatistics(ElementRasterizer(mesh), values.data(), parallel);
+    const ElementStatistics stats =
+      ComputeElementStatistics(ElementRasterizer(mesh), values.data(), parallel, AlgorithmProgress(this, 0.5, 0.9));
+    if (stats.Aborted)
+    {
+      return 1;
+    }
     std::vector<double> minAngle, radiusRatio;
     ElementQuality(mesh, minAngle, radiusRatio, parallel);
     const double statisticsSeconds = std::chrono::duration<double>(Clock::now() - t0).count();

@@ -53,8 +53,39 @@ ProgressFunction AlgorithmProgress(vtkAlgorithm* algorithm, double begin, double
 {
   return [=](double t) {
     algorithm->UpdateProgress(begin + (end - begin) * t);
-    return !algorithm->GetAbortExecute();
+    return !algorithm->CheckAbort();
   };
+}
+
+int ReportException(vtkAlgorithm* algorithm, const char* filter, const std::exception_ptr& error)
+{
+  try
+  {
+    std::rethrow_exception(error);
+  }
+  catch (const std::bad_alloc&)
+  {
+    vtkErrorWithObjectMacro(algorithm, << filter << ": out of memory; try a smaller image or fewer nodes.");
+  }
+  catch (const std::exception& e)
+  {
+    vtkErrorWithObjectMacro(algorithm, << filter << ": " << e.what());
+  }
+  catch (...)
+  {
+    vtkErrorWithObjectMacro(algorithm, << filter << ": an unknown error.");
+  }
+  return 0;
+}
+
+bool IsEmptyPiece(vtkInformationVector* outputVector, vtkDataObject* input)
+{
+  vtkInformation* info = outputVector->GetInformationObject(0);
+  const int piece = info->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
+    ? info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
+    : 0;
+  vtkDataSet* data = vtkDataSet::SafeDownCast(input);
+  return piece > 0 && (!input || (data && data->GetNumberOfPoints() == 0));
 }
 
 bool ImageGeometryOf(vtkImageData* image, ImageGeometry& geometry, std::string& error)
@@ -142,6 +173,30 @@ bool ImageGeometryFromFieldData(vtkDataObject* object, ImageGeometry& geometry, 
     return false;
   }
   geometry = g;
+  return true;
+}
+
+bool SameFrame(const ImageGeometry& a, const ImageGeometry& b)
+{
+  if (a.Dims != b.Dims)
+  {
+    return false;
+  }
+  const double tol = 1e-9 * std::max({ std::fabs(a.Spacing[0]), std::fabs(a.Spacing[1]), std::fabs(a.Spacing[2]) });
+  for (int k = 0; k < 3; ++k)
+  {
+    if (std::fabs(a.Origin[k] - b.Origin[k]) > tol || std::fabs(a.Spacing[k] - b.Spacing[k]) > tol)
+    {
+      return false;
+    }
+  }
+  for (int k = 0; k < 9; ++k)
+  {
+    if (std::fabs(a.Direction[k] - b.Direction[k]) > 1e-9)
+    {
+      return false;
+    }
+  }
   return true;
 }
 

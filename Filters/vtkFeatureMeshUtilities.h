@@ -12,6 +12,7 @@
 #include "vtkSMPTools.h"
 
 #include <cstdlib>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -26,24 +27,42 @@ class vtkUnstructuredGrid;
 
 namespace featuremesh
 {
-// Runs `body` (returning int) on the STDThread SMP backend when VTK runs its Sequential default
-// and the user chose none with VTK_SMP_BACKEND_IN_USE; the host's backend is left as it was.
+// Reports an exception that escaped a filter's body as its error (out of memory, or a library's
+// failure); returns 0.
+int ReportException(vtkAlgorithm* algorithm, const char* filter, const std::exception_ptr& error);
+
+// Runs a filter's body (returning int): on the STDThread SMP backend when VTK runs its Sequential
+// default and the user chose none with VTK_SMP_BACKEND_IN_USE (the host's backend is left as it
+// was), and with every exception caught at the VTK boundary.
 template <typename Body>
-int WithThreads(Body&& body)
+int RunFilter(vtkAlgorithm* algorithm, const char* filter, Body&& body)
 {
-  if (std::getenv("VTK_SMP_BACKEND_IN_USE") || std::string(vtkSMPTools::GetBackend()) != "Sequential")
+  try
   {
-    return body();
+    if (std::getenv("VTK_SMP_BACKEND_IN_USE") || std::string(vtkSMPTools::GetBackend()) != "Sequential")
+    {
+      return body();
+    }
+    int result = 0;
+    vtkSMPTools::LocalScope(vtkSMPTools::Config(std::string("STDThread")), [&]() { result = body(); });
+    return result;
   }
-  int result = 0;
-  vtkSMPTools::LocalScope(vtkSMPTools::Config(std::string("STDThread")), [&]() { result = body(); });
-  return result;
+  catch (...)
+  {
+    return ReportException(algorithm, filter, std::current_exception());
+  }
 }
+
+// True on a parallel process that holds no piece of the data: the input is empty and this is not
+// piece 0. The filters then succeed with empty outputs and say nothing (the whole image is on one
+// process; see docs/CONTRACT.md).
+bool IsEmptyPiece(vtkInformationVector* outputVector, vtkDataObject* input);
 
 // A parallel-for on vtkSMPTools.
 ParallelFor SMPParallelFor();
 
-// Maps core progress [0,1] to [begin,end] of the algorithm's progress; false once abort is asked.
+// Maps core progress [0,1] to [begin,end] of the algorithm's progress; false once abort is asked
+// (CheckAbort: the executive then clears the outputs and re-executes on the next update).
 ProgressFunction AlgorithmProgress(vtkAlgorithm* algorithm, double begin, double end);
 
 // The frame of an image (its extent's first voxel is index 0), or an error sentence: the image
@@ -54,6 +73,9 @@ bool ImageGeometryOf(vtkImageData* image, ImageGeometry& geometry, std::string& 
 // that later stages can rasterise onto the grid without the image.
 void AddImageGeometry(const ImageGeometry& geometry, vtkDataObject* object);
 bool ImageGeometryFromFieldData(vtkDataObject* object, ImageGeometry& geometry, std::string& error);
+
+// True when two frames describe the same grid (to 1e-9 of the spacing).
+bool SameFrame(const ImageGeometry& a, const ImageGeometry& b);
 
 // Gives `image` the frame's extent (from 0), origin, spacing and direction.
 void SetImageFrame(vtkImageData* image, const ImageGeometry& geometry);

@@ -87,7 +87,7 @@ int vtkFeatureNodes::RequestUpdateExtent(
 int vtkFeatureNodes::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return featuremesh::WithThreads([&]() { return this->Execute(inputVector, outputVector); });
+  return featuremesh::RunFilter(this, "Feature Nodes", [&]() { return this->Execute(inputVector, outputVector); });
 }
 
 int vtkFeatureNodes::Execute(vtkInformationVector** inputVector, vtkInformationVector* outputVector)
@@ -102,6 +102,10 @@ int vtkFeatureNodes::Execute(vtkInformationVector** inputVector, vtkInformationV
 
   std::string error;
   ImageGeometry grid;
+  if (IsEmptyPiece(outputVector, input))
+  {
+    return 1;
+  }
   if (!ImageGeometryOf(input, grid, error))
   {
     vtkErrorMacro("Feature Nodes: " << error);

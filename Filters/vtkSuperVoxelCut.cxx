@@ -87,7 +87,7 @@ int vtkSuperVoxelCut::RequestUpdateExtent(
 int vtkSuperVoxelCut::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return featuremesh::WithThreads([&]() -> int {
+  return featuremesh::RunFilter(this, "Super-Voxel Cut", [&]() -> int {
     using namespace featuremesh;
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
@@ -115,6 +115,10 @@ int vtkSuperVoxelCut::RequestData(
     {
       return fail(error);
     }
+    if (IsEmptyPiece(outputVector, input))
+    {
+      return 1;
+    }
     if (!input || input->GetNumberOfCells() == 0)
     {
       return fail("the mesh is empty.");
@@ -130,6 +134,13 @@ int vtkSuperVoxelCut::RequestData(
     if (image ? !ImageGeometryOf(image, geometry, error) : !ImageGeometryFromFieldData(input, geometry, error))
     {
       return fail(error);
+    }
+    ImageGeometry meshFrame;
+    std::string ignored;
+    if (image && ImageGeometryFromFieldData(input, meshFrame, ignored) && !SameFrame(meshFrame, geometry))
+    {
+      return fail("the mesh was made on another image grid than the connected Image (dimensions, origin, spacing or "
+                  "direction differ); connect the image the mesh was made from.");
     }
     SimplexMesh mesh;
     if (!ToSimplexMesh(input, geometry, mesh, error))
@@ -165,14 +176,15 @@ int vtkSuperVoxelCut::RequestData(
     this->UpdateProgress(0.2);
     const ParallelFor parallel = SMPParallelFor();
     const SuperVoxelCutResult result = featuremesh::SuperVoxelCut(
-      mesh, mean, count, objectVoxels, backgroundVoxels, image ? values.data() : nullptr, par, parallel);
+      mesh, mean, count, objectVoxels, backgroundVoxels, image ? values.data() : nullptr, par, parallel,
+      AlgorithmProgress(this, 0.2, 0.95));
+    if (result.Aborted)
+    {
+      return 1;
+    }
     if (!result.Error.empty())
     {
       return fail(result.Error);
-    }
-    if (this->GetAbortExecute())
-    {
-      return 1;
     }
     this->UpdateProgress(0.7);
     const CutResult& cut = result.Cut;

@@ -59,68 +59,79 @@ int vtkVoxelCut::RequestUpdateExtent(vtkInformation*, vtkInformationVector** inp
 
 int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  using namespace featuremesh;
-  const auto start = std::chrono::steady_clock::now();
-  vtkImageData* image = vtkImageData::GetData(inputVector[0], 0);
-  vtkPointSet* objectSeeds = vtkPointSet::GetData(inputVector[1], 0);
-  vtkPointSet* backgroundSeeds = vtkPointSet::GetData(inputVector[2], 0);
-  vtkImageData* output = vtkImageData::GetData(outputVector, 0);
-  std::string error, warning;
-  auto fail = [&](const std::string& why) {
-    vtkErrorMacro("Voxel Cut: " << why);
-    return 0;
-  };
-  ImageGeometry geometry;
-  if (!ImageGeometryOf(image, geometry, error))
-  {
-    return fail(error);
-  }
-  VoxelCutParameters par;
-  par.Bins = this->Bins;
-  par.Sigma = this->Sigma;
-  par.Lambda = this->Lambda;
-  par.SeedRadius = this->SeedRadius;
-  error = ValidateParameters(par);
-  if (!error.empty())
-  {
-    return fail(error);
-  }
-  std::vector<std::int64_t> objectVoxels, backgroundVoxels;
-  if (!SeedVoxels(PointsOf(objectSeeds), geometry, "object", objectVoxels, error) ||
-    !SeedVoxels(PointsOf(backgroundSeeds), geometry, "background", backgroundVoxels, error))
-  {
-    return fail(error);
-  }
-  std::vector<double> values;
-  const bool valuesOk = ChosenValues(image, this->GetInputArrayInformation(0), values, error, warning);
-  if (!warning.empty())
-  {
-    vtkWarningMacro("Voxel Cut: " << warning);
-  }
-  if (!valuesOk)
-  {
-    return fail(error);
-  }
-  this->UpdateProgress(0.2);
-  const CutResult cut = featuremesh::VoxelCut(std::move(values), geometry, objectVoxels, backgroundVoxels, par);
-  if (!cut.Error.empty())
-  {
-    return fail(cut.Error);
-  }
-  SetImageFrame(output, geometry);
-  vtkNew<vtkUnsignedCharArray> labels;
-  labels->SetName(names::Label);
-  labels->SetNumberOfTuples(geometry.Size());
-  std::copy(cut.Label.begin(), cut.Label.end(), labels->GetPointer(0));
-  output->GetPointData()->SetScalars(labels);
-  AddFieldValue(output, names::Sigma, cut.Sigma);
-  AddFieldValue(output, names::Bins, cut.Bins);
-  AddFieldValue(output, names::Flow, cut.Flow);
-  AddFieldValue(output, names::GraphSeconds, cut.GraphSeconds);
-  AddFieldValue(output, names::FlowSeconds, cut.FlowSeconds);
-  AddFieldValue(output, names::TotalSeconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  this->UpdateProgress(1.0);
-  return 1;
+  return featuremesh::RunFilter(this, "Voxel Cut", [&]() -> int {
+    using namespace featuremesh;
+    const auto start = std::chrono::steady_clock::now();
+    vtkImageData* image = vtkImageData::GetData(inputVector[0], 0);
+    vtkPointSet* objectSeeds = vtkPointSet::GetData(inputVector[1], 0);
+    vtkPointSet* backgroundSeeds = vtkPointSet::GetData(inputVector[2], 0);
+    vtkImageData* output = vtkImageData::GetData(outputVector, 0);
+    std::string error, warning;
+    auto fail = [&](const std::string& why) {
+      vtkErrorMacro("Voxel Cut: " << why);
+      return 0;
+    };
+    ImageGeometry geometry;
+    if (IsEmptyPiece(outputVector, image))
+    {
+      return 1;
+    }
+    if (!ImageGeometryOf(image, geometry, error))
+    {
+      return fail(error);
+    }
+    VoxelCutParameters par;
+    par.Bins = this->Bins;
+    par.Sigma = this->Sigma;
+    par.Lambda = this->Lambda;
+    par.SeedRadius = this->SeedRadius;
+    error = ValidateParameters(par);
+    if (!error.empty())
+    {
+      return fail(error);
+    }
+    std::vector<std::int64_t> objectVoxels, backgroundVoxels;
+    if (!SeedVoxels(PointsOf(objectSeeds), geometry, "object", objectVoxels, error) ||
+      !SeedVoxels(PointsOf(backgroundSeeds), geometry, "background", backgroundVoxels, error))
+    {
+      return fail(error);
+    }
+    std::vector<double> values;
+    const bool valuesOk = ChosenValues(image, this->GetInputArrayInformation(0), values, error, warning);
+    if (!warning.empty())
+    {
+      vtkWarningMacro("Voxel Cut: " << warning);
+    }
+    if (!valuesOk)
+    {
+      return fail(error);
+    }
+    this->UpdateProgress(0.2);
+    const CutResult cut = featuremesh::VoxelCut(
+      std::move(values), geometry, objectVoxels, backgroundVoxels, par, AlgorithmProgress(this, 0.2, 0.95));
+    if (cut.Aborted)
+    {
+      return 1;
+    }
+    if (!cut.Error.empty())
+    {
+      return fail(cut.Error);
+    }
+    SetImageFrame(output, geometry);
+    vtkNew<vtkUnsignedCharArray> labels;
+    labels->SetName(names::Label);
+    labels->SetNumberOfTuples(geometry.Size());
+    std::copy(cut.Label.begin(), cut.Label.end(), labels->GetPointer(0));
+    output->GetPointData()->SetScalars(labels);
+    AddFieldValue(output, names::Sigma, cut.Sigma);
+    AddFieldValue(output, names::Bins, cut.Bins);
+    AddFieldValue(output, names::Flow, cut.Flow);
+    AddFieldValue(output, names::GraphSeconds, cut.GraphSeconds);
+    AddFieldValue(output, names::FlowSeconds, cut.FlowSeconds);
+    AddFieldValue(output, names::TotalSeconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    this->UpdateProgress(1.0);
+    return 1;
+  });
 }
 
 void vtkVoxelCut::PrintSelf(ostream& os, vtkIndent indent)

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 #include <numeric>
+#include <stdexcept>
 
 namespace featuremesh
 {
@@ -44,9 +45,9 @@ std::string ValidateParameters(const BoykovJollyParameters& p)
   {
     return "sigma must be 0 (automatic) or positive.";
   }
-  if (!(p.Lambda >= 0.0) || !std::isfinite(p.Lambda))
+  if (!(p.Lambda >= 0.0 && p.Lambda <= 1e6))
   {
-    return "lambda must be a finite, non-negative number.";
+    return "lambda must lie in [0, 1e6].";
   }
   return std::string();
 }
@@ -99,7 +100,81 @@ std::vector<double> SmoothedHistogram(
   return density;
 }
 
-CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par)
+namespace
+{
+// libmaxflow calls this before exit(1) when an allocation fails: throwing keeps the host alive.
+void ThrowOutOfMemory(const char* what)
+{
+  throw std::runtime_error(std::string("max-flow: ") + what);
+}
+
+// Values whose squares and sums stay finite in double precision.
+constexpr double LargestIntensity = 1e150;
+
+bool Usable(double v)
+{
+  return std::isfinite(v) && std::fabs(v) <= LargestIntensity;
+}
+
+// Empty when every input of the energy is usable, else a sentence.
+std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progress, bool& aborted)
+{
+  const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
+  const std::int64_t m = static_cast<std::int64_t>(pr.A.size());
+  if (static_cast<std::int64_t>(pr.Size.size()) != n || static_cast<std::int64_t>(pr.Hard.size()) != n ||
+    static_cast<std::int64_t>(pr.B.size()) != m || static_cast<std::int64_t>(pr.Contact.size()) != m)
+  {
+    return "the graph's arrays disagree in length.";
+  }
+  std::int64_t badValue = 0, badSize = 0, badEdge = 0;
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    badValue += Usable(pr.Value[p]) ? 0 : 1;
+    badSize += (std::isfinite(pr.Size[p]) && pr.Size[p] >= 0.0) ? 0 : 1;
+  }
+  for (std::int64_t e = 0; e < m; ++e)
+  {
+    badEdge += (pr.A[e] >= 0 && pr.A[e] < n && pr.B[e] >= 0 && pr.B[e] < n && std::isfinite(pr.Contact[e]) &&
+                 pr.Contact[e] >= 0.0)
+      ? 0
+      : 1;
+  }
+  for (const auto* samples : { &pr.ObjectSamples, &pr.BackgroundSamples })
+  {
+    for (double v : *samples)
+    {
+      badValue += Usable(v) ? 0 : 1;
+    }
+  }
+  if (pr.VoxelValue && pr.VoxelOwner)
+  {
+    for (std::int64_t v = 0; v < pr.VoxelTotal; ++v)
+    {
+      badValue += Usable(pr.VoxelValue[v]) ? 0 : 1;
+      if ((v & 0xFFFFF) == 0xFFFFF && !progress(static_cast<double>(v) / static_cast<double>(pr.VoxelTotal)))
+      {
+        aborted = true;
+        return std::string();
+      }
+    }
+  }
+  if (badValue)
+  {
+    return std::to_string(badValue) + " intensities are NaN, infinite or beyond +-1e150; replace or rescale them (e.g. with a Calculator) first.";
+  }
+  if (badSize)
+  {
+    return std::to_string(badSize) + " node sizes (voxel counts) are negative or not finite.";
+  }
+  if (badEdge)
+  {
+    return std::to_string(badEdge) + " graph edges name missing nodes or have a negative or non-finite contact.";
+  }
+  return std::string();
+}
+} // namespace
+
+CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par, const ProgressFunction& progress)
 {
   CutResult r;
   const auto t0 = Clock::now();
@@ -113,6 +188,29 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par)
   if (n > static_cast<std::int64_t>(2000000000) || 2 * m > static_cast<std::int64_t>(2000000000))
   {
     r.Error = "the graph is too large for the max-flow library (node ids are 32-bit).";
+    return r;
+  }
+  r.Error = ValidateProblem(pr, SubProgress(progress, 0.0, 0.05), r.Aborted);
+  if (!r.Error.empty() || r.Aborted)
+  {
+    return r;
+  }
+  // Every loop below checks for an abort about every million steps.
+  auto aborted = [&](std::int64_t i, std::int64_t count, double begin, double end) {
+    if ((i & 0xFFFFF) != 0xFFFFF)
+    {
+      return false;
+    }
+    r.Aborted = !progress(begin + (end - begin) * static_cast<double>(i) / static_cast<double>(count));
+    return r.Aborted;
+  };
+  // And at the end of every phase.
+  auto phaseAborted = [&](double done) {
+    r.Aborted = !progress(done);
+    return r.Aborted;
+  };
+  if (phaseAborted(0.05))
+  {
     return r;
   }
   r.Bins = par.Bins > 0 ? par.Bins : 64;
@@ -162,17 +260,27 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par)
     }
   }
   const double inv2s2 = 1.0 / (2.0 * r.Sigma * r.Sigma);
+  if (phaseAborted(0.1))
+  {
+    return r;
+  }
 
-  using G = maxflow::Graph_DDD;
-  auto g = std::make_unique<G>(static_cast<int>(n), static_cast<int>(m));
-  g->add_node(static_cast<int>(n));
   std::vector<double> weight(m);
   double total = 1.0;
   for (std::int64_t e = 0; e < m; ++e)
   {
     const double d = pr.Value[pr.A[e]] - pr.Value[pr.B[e]];
-    weight[e] = pr.Contact[e] * std::exp(-d * d * inv2s2);
+    // Equal neighbours have weight 1 whatever sigma (a tiny sigma would give 0 * inf).
+    weight[e] = pr.Contact[e] * (d == 0.0 ? 1.0 : std::exp(-d * d * inv2s2));
     total += weight[e];
+    if (aborted(e, m, 0.1, 0.2))
+    {
+      return r;
+    }
+  }
+  if (phaseAborted(0.2))
+  {
+    return r;
   }
   // Region costs of each node: labelled object it pays regionObject, labelled background regionBackground.
   std::vector<double> regionObject(n), regionBackground(n);
@@ -186,6 +294,10 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par)
         const int b = bin(pr.VoxelValue[v]);
         regionObject[p] += costObject[b];
         regionBackground[p] += costBackground[b];
+      }
+      if (aborted(v, pr.VoxelTotal, 0.2, 0.35))
+      {
+        return r;
       }
     }
   }
@@ -204,37 +316,96 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par)
     regionBackground[p] *= par.Lambda;
     total += std::max(regionObject[p], regionBackground[p]);
   }
+  if (phaseAborted(0.35))
+  {
+    return r;
+  }
   // K exceeds the energy of any labelling, so hard constraints are never cut.
   const double K = total;
-  for (std::int64_t p = 0; p < n; ++p)
+  if (!std::isfinite(K))
   {
-    if (pr.Hard[p] == 1)
+    r.Error = "the energy overflows (lambda, the contact areas or the graph are too large); lower lambda.";
+    return r;
+  }
+  using G = maxflow::Graph_DDD;
+  std::shared_ptr<G> g;
+  try
+  {
+    g = std::make_shared<G>(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory);
+    g->add_node(static_cast<int>(n));
+    for (std::int64_t p = 0; p < n; ++p)
     {
-      g->add_tweights(static_cast<int>(p), K, 0.0);
+      if (pr.Hard[p] == 1)
+      {
+        g->add_tweights(static_cast<int>(p), K, 0.0);
+      }
+      else if (pr.Hard[p] == 2)
+      {
+        g->add_tweights(static_cast<int>(p), 0.0, K);
+      }
+      else
+      {
+        // Source = object: a node left on the source side pays its sink capacity.
+        g->add_tweights(static_cast<int>(p), regionBackground[p], regionObject[p]);
+      }
     }
-    else if (pr.Hard[p] == 2)
+    for (std::int64_t e = 0; e < m; ++e)
     {
-      g->add_tweights(static_cast<int>(p), 0.0, K);
-    }
-    else
-    {
-      // Source = object: a node left on the source side pays its sink capacity.
-      g->add_tweights(static_cast<int>(p), regionBackground[p], regionObject[p]);
+      g->add_edge(static_cast<int>(pr.A[e]), static_cast<int>(pr.B[e]), weight[e], weight[e]);
+      if (aborted(e, m, 0.35, 0.5))
+      {
+        return r;
+      }
     }
   }
-  for (std::int64_t e = 0; e < m; ++e)
+  catch (const std::exception&)
   {
-    g->add_edge(static_cast<int>(pr.A[e]), static_cast<int>(pr.B[e]), weight[e], weight[e]);
+    r.Error = "not enough memory for the max-flow graph (" + std::to_string(n) + " nodes, " + std::to_string(m) + " edges).";
+    return r;
   }
   const auto t1 = Clock::now();
   r.GraphSeconds = std::chrono::duration<double>(t1 - t0).count();
-  r.Flow = g->maxflow();
-  r.Label.resize(n);
+  // The max-flow has no progress or abort of its own: it runs on its own thread, owning the graph.
+  using Flow = std::pair<double, std::vector<std::uint8_t>>;
+  Flow flow;
+  try
+  {
+    const bool done = RunWithHeartbeat<Flow>(
+      [g, n]() {
+        Flow f;
+        f.first = g->maxflow();
+        f.second.resize(n);
+        for (std::int64_t p = 0; p < n; ++p)
+        {
+          f.second[p] = g->what_segment(static_cast<int>(p)) == G::SOURCE ? 1 : 0;
+        }
+        return f;
+      },
+      SubProgress(progress, 0.5, 1.0), flow);
+    if (!done)
+    {
+      r.Aborted = true;
+      return r;
+    }
+  }
+  catch (const std::exception&)
+  {
+    r.Error = "not enough memory for the max-flow (" + std::to_string(n) + " nodes, " + std::to_string(m) + " edges).";
+    return r;
+  }
+  r.Flow = flow.first;
+  r.Label = std::move(flow.second);
+  r.FlowSeconds = std::chrono::duration<double>(Clock::now() - t1).count();
+  // Hard constraints hold by construction; a non-finite energy would break them silently.
   for (std::int64_t p = 0; p < n; ++p)
   {
-    r.Label[p] = g->what_segment(static_cast<int>(p)) == G::SOURCE ? 1 : 0;
+    if ((pr.Hard[p] == 1 && r.Label[p] != 1) || (pr.Hard[p] == 2 && r.Label[p] != 0) || !std::isfinite(r.Flow))
+    {
+      r.Label.clear();
+      r.Error = "the max-flow did not honour the seeds (a non-finite energy); please report this input.";
+      return r;
+    }
   }
-  r.FlowSeconds = std::chrono::duration<double>(Clock::now() - t1).count();
   return r;
 }
 } // namespace featuremesh

@@ -12,6 +12,8 @@
 // that are constant on elements.
 #pragma once
 
+#include "Parallel.h"
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -54,6 +56,7 @@ struct CutResult
   int Bins = 0;
   double GraphSeconds = 0.0, FlowSeconds = 0.0;
   std::string Error;
+  bool Aborted = false;
 };
 
 std::string ValidateParameters(const BoykovJollyParameters& p);
@@ -63,5 +66,10 @@ std::string ValidateParameters(const BoykovJollyParameters& p);
 std::vector<double> SmoothedHistogram(const std::vector<double>& samples, const std::vector<double>& weights,
   double low, double high, int bins);
 
-CutResult BoykovJollyCut(const CutProblem& problem, const BoykovJollyParameters& parameters);
+// Every input is checked first (finite values within +-1e150, non-negative sizes and contacts,
+// edges naming nodes): a problem is an Error sentence, never a NaN in a capacity. Running out of
+// memory is an Error, not an exit. Progress is reported on the caller's thread; when it asks to
+// abort, the result is Aborted (the max-flow is then left to finish on its own thread).
+CutResult BoykovJollyCut(const CutProblem& problem, const BoykovJollyParameters& parameters,
+  const ProgressFunction& progress = NoProgress());
 } // namespace featuremesh

@@ -48,7 +48,7 @@ double InterpolateAt(const double* values, const ImageGeometry& g, const double 
 }
 
 ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, const double* values,
-  const ParallelFor& parallel)
+  const ParallelFor& parallel, const ProgressFunction& progress)
 {
   const SimplexMesh& mesh = raster.Mesh();
   const auto& P = mesh.Points();
@@ -59,7 +59,7 @@ ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, cons
   s.Mean.assign(m, 0.0);
   s.StdDev.assign(m, 0.0);
   s.Interpolated.assign(m, 0);
-  parallel(m, 512, [&](std::int64_t b, std::int64_t e) {
+  s.Aborted = !BatchedFor(m, 512, parallel, progress, [&](std::int64_t b, std::int64_t e) {
     for (std::int64_t c = b; c < e; ++c)
     {
       // One pass with sums shifted by the element's first value: no cancellation for large,
@@ -101,17 +101,18 @@ ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, cons
   return s;
 }
 
-std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const ParallelFor& parallel)
+std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const ParallelFor& parallel,
+  const ProgressFunction& progress)
 {
   std::vector<std::int64_t> owner(raster.Mesh().Geometry().Size(), -1);
   // Each centre has exactly one owner, so the writes never collide.
-  parallel(raster.NumberOfElements(), 512, [&](std::int64_t b, std::int64_t e) {
+  const bool done = BatchedFor(raster.NumberOfElements(), 512, parallel, progress, [&](std::int64_t b, std::int64_t e) {
     for (std::int64_t c = b; c < e; ++c)
     {
       raster.ForEachVoxel(c, [&](std::int64_t v) { owner[v] = c; });
     }
   });
-  return owner;
+  return done ? owner : std::vector<std::int64_t>();
 }
 
 namespace

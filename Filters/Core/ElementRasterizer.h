@@ -43,6 +43,7 @@ private:
 // value interpolated at their centroid and are flagged.
 struct ElementStatistics
 {
+  bool Aborted = false;
   std::vector<std::int64_t> PixelCount;
   std::vector<double> Mean;
   std::vector<double> StdDev;
@@ -50,10 +51,12 @@ struct ElementStatistics
 };
 // `values` has one value per voxel of the mesh's image.
 ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, const double* values,
-  const ParallelFor& parallel);
+  const ParallelFor& parallel, const ProgressFunction& progress = NoProgress());
 
 // Owner element of every voxel (-1 where none, which only happens when the mesh does not tile the box).
-std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const ParallelFor& parallel);
+// Empty when progress asked to abort.
+std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const ParallelFor& parallel,
+  const ProgressFunction& progress = NoProgress());
 
 // Quality in frame (world) units: minimum angle (triangles) or minimum dihedral angle (tetrahedra)
 // in degrees, and the radius ratio normalised to 1 for the equilateral element (2r/R, 3r/R).

@@ -63,6 +63,29 @@ std::vector<int> EvenPositions(int extent, int spacing)
   }
   return pos;
 }
+// 0 when the largest |value| lies in [2^-40, 2^40] (or all are 0), else its binary exponent.
+int ExtremeMagnitudeExponent(const float* v, std::int64_t n, const ParallelFor& parallel)
+{
+  std::vector<float> blockMax(ReductionBlocks, 0.f);
+  const std::int64_t block = (n + ReductionBlocks - 1) / ReductionBlocks;
+  parallel(ReductionBlocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+    for (std::int64_t b = b0; b < b1; ++b)
+    {
+      float m = 0.f;
+      for (std::int64_t i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
+      {
+        m = std::max(m, std::fabs(v[i]));
+      }
+      blockMax[b] = m;
+    }
+  });
+  const float largest = *std::max_element(blockMax.begin(), blockMax.end());
+  if (largest == 0.f || (largest >= std::ldexp(1.f, -40) && largest <= std::ldexp(1.f, 40)))
+  {
+    return 0;
+  }
+  return std::ilogb(largest);
+}
 } // namespace
 
 std::string ValidateParameters(const FeatureNodeParameters& p)
@@ -134,6 +157,22 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
   float* f = bufferA.get();
   float* work = bufferB.get();
   auto t0 = Clock::now();
+  // The recipe is scale-invariant (thresholds are fractions of maxima), and scaling by a power of
+  // two is exact: images of extreme magnitude, whose gradients would overflow or underflow float,
+  // are brought near 1 first; all others are read as they are.
+  std::vector<float> rescaled;
+  const int exponent = ExtremeMagnitudeExponent(image, n, parallel);
+  if (exponent)
+  {
+    rescaled.resize(n);
+    parallel(n, 65536, [&](std::int64_t b, std::int64_t e) {
+      for (std::int64_t i = b; i < e; ++i)
+      {
+        rescaled[i] = std::ldexp(image[i], -exponent);
+      }
+    });
+    image = rescaled.data();
+  }
   GaussianSmooth(image, f, g, p.GaussianSigma, parallel);
   out.StepSeconds.emplace_back("gaussian", SecondsSince(t0));
   if (!progress(0.1))

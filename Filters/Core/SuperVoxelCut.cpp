@@ -59,14 +59,19 @@ std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale)
 SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<double>& mean,
   const std::vector<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
   const std::vector<std::int64_t>& backgroundVoxels, const double* voxelValues,
-  const SuperVoxelCutParameters& parameters, const ParallelFor& parallel)
+  const SuperVoxelCutParameters& parameters, const ParallelFor& parallel, const ProgressFunction& progress)
 {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   SuperVoxelCutResult result;
   const std::int64_t m = mesh.NumberOfElements();
   const ElementRasterizer raster(mesh);
-  result.VoxelOwner = VoxelOwners(raster, parallel);
+  result.VoxelOwner = VoxelOwners(raster, parallel, SubProgress(progress, 0.0, 0.3));
+  if (result.VoxelOwner.empty())
+  {
+    result.Aborted = true;
+    return result;
+  }
   const std::vector<std::int64_t>& owner = result.VoxelOwner;
 
   CutProblem pr;
@@ -117,8 +122,9 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<dou
     }
   }
   result.SetupSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  result.Cut = BoykovJollyCut(pr, parameters);
-  if (!result.Cut.Error.empty())
+  result.Cut = BoykovJollyCut(pr, parameters, SubProgress(progress, 0.3, 1.0));
+  result.Aborted = result.Cut.Aborted;
+  if (!result.Cut.Error.empty() || result.Aborted)
   {
     result.Error = result.Cut.Error;
     return result;
@@ -152,7 +158,7 @@ std::string ValidateParameters(const VoxelCutParameters& p)
 
 CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
   const std::vector<std::int64_t>& objectVoxels, const std::vector<std::int64_t>& backgroundVoxels,
-  const VoxelCutParameters& parameters)
+  const VoxelCutParameters& parameters, const ProgressFunction& progress)
 {
   CutResult failed;
   const std::int64_t n = g.Size();
@@ -202,6 +208,12 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
   pr.A.reserve(edges);
   pr.B.reserve(edges);
   for (int k = 0; k < g.Dims[2]; ++k)
+  {
+    if (!progress(0.1 * k / g.Dims[2]))
+    {
+      failed.Aborted = true;
+      return failed;
+    }
     for (int j = 0; j < g.Dims[1]; ++j)
       for (int i = 0; i < g.Dims[0]; ++i)
       {
@@ -222,7 +234,8 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
           pr.B.push_back(v + sz);
         }
       }
+  }
   pr.Contact.assign(pr.A.size(), 1.0);
-  return BoykovJollyCut(pr, parameters);
+  return BoykovJollyCut(pr, parameters, SubProgress(progress, 0.1, 1.0));
 }
 } // namespace featuremesh

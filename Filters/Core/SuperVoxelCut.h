@@ -40,6 +40,7 @@ struct SuperVoxelCutResult
   std::vector<std::int64_t> BoundaryFaces;
   double SetupSeconds = 0.0;
   std::string Error;
+  bool Aborted = false;
 };
 
 // Hard constraints (0 free, 1 object, 2 background) of the nodes owning the seed voxels; false
@@ -59,7 +60,8 @@ std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale);
 SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<double>& mean,
   const std::vector<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
   const std::vector<std::int64_t>& backgroundVoxels, const double* voxelValues,
-  const SuperVoxelCutParameters& parameters, const ParallelFor& parallel);
+  const SuperVoxelCutParameters& parameters, const ParallelFor& parallel,
+  const ProgressFunction& progress = NoProgress());
 
 // The labels of the elements on the voxel grid (0 where no element owns a voxel).
 std::vector<std::uint8_t> VoxelLabels(const std::vector<std::int64_t>& owner, const std::vector<std::uint8_t>& label,
@@ -69,7 +71,7 @@ std::vector<std::uint8_t> VoxelLabels(const std::vector<std::int64_t>& owner, co
 // voxel) is moved in, not copied.
 CutResult VoxelCut(std::vector<double> values, const ImageGeometry& geometry,
   const std::vector<std::int64_t>& objectVoxels, const std::vector<std::int64_t>& backgroundVoxels,
-  const VoxelCutParameters& parameters);
+  const VoxelCutParameters& parameters, const ProgressFunction& progress = NoProgress());
 
 // Empty when usable, else a sentence.
 std::string ValidateParameters(const VoxelCutParameters& p);

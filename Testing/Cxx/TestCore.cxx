@@ -17,7 +17,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
+#include <thread>
 #include <numeric>
 #include <random>
 
@@ -908,4 +910,98 @@ TEST(Kernels, HalftoneMatchesErrorDiffusionOnTheWholeVolume)
       EXPECT_EQ(fast, dots) << g.Dims[0] << "x" << g.Dims[1] << "x" << g.Dims[2] << " q " << q;
       EXPECT_GT(dots.size(), 10u);
     }
+}
+
+//------------------------------------------------------------------------------------------------
+// Guards: what a bad input does is an error or a correct result, never a NaN in the output.
+TEST(Guards, ExtremeMagnitudesGiveTheSameNodes)
+{
+  ImageGeometry g = Grid2(64, 64);
+  const std::vector<float> f = Disk(g, 30.5, 28.0, 14.0);
+  FeatureNodeParameters p;
+  const FeatureNodeResult plain = ComputeFeatureNodes(f.data(), nullptr, g, p, SerialFor(), NoProgress());
+  for (int e : { 100, -100, 120 })
+  {
+    std::vector<float> scaled(f);
+    for (float& v : scaled)
+      v = std::ldexp(v, e);
+    const FeatureNodeResult r = ComputeFeatureNodes(scaled.data(), nullptr, g, p, SerialFor(), NoProgress());
+    EXPECT_EQ(r.Positions, plain.Positions) << "scaled by 2^" << e;
+    EXPECT_EQ(r.Type, plain.Type);
+  }
+  // Steps near the float limit (gradients would overflow) still give edges on the disk.
+  std::vector<float> huge(f);
+  for (float& v : huge)
+    v = v > 50.f ? 3e38f : -3e38f;
+  const FeatureNodeResult r = ComputeFeatureNodes(huge.data(), nullptr, g, p, SerialFor(), NoProgress());
+  EXPECT_GT(r.Counts[int(NodeType::Canny)], 10);
+}
+
+TEST(Guards, EnergyInputsAreCheckedAndSeedsAlwaysHold)
+{
+  CutProblem pr = SeededChain({ 5, 5, 5, 5, 0, 0, 0, 0 });
+  pr.ObjectSamples = { 5.0 };
+  pr.BackgroundSamples = { 0.0 };
+  // A tiny sigma with equal neighbours once gave 0 * inf = NaN capacities.
+  BoykovJollyParameters tiny;
+  tiny.Sigma = 1e-300;
+  CutResult r = BoykovJollyCut(pr, tiny);
+  ASSERT_TRUE(r.Error.empty()) << r.Error;
+  EXPECT_TRUE(std::isfinite(r.Flow));
+  EXPECT_EQ(r.Label.front(), 1);
+  EXPECT_EQ(r.Label.back(), 0);
+  // Non-finite or too large intensities, negative sizes and contacts are errors.
+  CutProblem bad = pr;
+  bad.Value[2] = std::nan("");
+  EXPECT_NE(BoykovJollyCut(bad, BoykovJollyParameters()).Error.find("NaN"), std::string::npos);
+  bad = pr;
+  bad.Value[2] = 1e300;
+  EXPECT_FALSE(BoykovJollyCut(bad, BoykovJollyParameters()).Error.empty());
+  bad = pr;
+  bad.Size[1] = -1;
+  EXPECT_FALSE(BoykovJollyCut(bad, BoykovJollyParameters()).Error.empty());
+  bad = pr;
+  bad.Contact[0] = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(BoykovJollyCut(bad, BoykovJollyParameters()).Error.empty());
+  bad = pr;
+  bad.B[0] = 99;
+  EXPECT_FALSE(BoykovJollyCut(bad, BoykovJollyParameters()).Error.empty());
+  BoykovJollyParameters huge;
+  huge.Lambda = 1e300;
+  EXPECT_FALSE(ValidateParameters(huge).empty());
+  // An abort before the flow comes back as Aborted, with no labels.
+  int calls = 0;
+  const CutResult aborted = BoykovJollyCut(pr, BoykovJollyParameters(), [&](double) { return ++calls < 2; });
+  EXPECT_TRUE(aborted.Aborted);
+  EXPECT_TRUE(aborted.Label.empty());
+}
+
+TEST(Guards, HeartbeatReportsAbortsAndRethrows)
+{
+  int beats = 0;
+  int value = 0;
+  EXPECT_TRUE(RunWithHeartbeat<int>(
+    [] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(120));
+      return 7;
+    },
+    [&](double t) {
+      EXPECT_GE(t, 0.0);
+      EXPECT_LT(t, 1.0);
+      ++beats;
+      return true;
+    },
+    value, std::chrono::milliseconds(20)));
+  EXPECT_EQ(value, 7);
+  EXPECT_GE(beats, 2);
+  // Abort: returns at the next beat, long before the task ends.
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(RunWithHeartbeat<int>(
+    [] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+      return 1;
+    },
+    [](double) { return false; }, value, std::chrono::milliseconds(20)));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 0.5);
+  EXPECT_THROW(RunWithHeartbeat<int>([]() -> int { throw std::bad_alloc(); }, NoProgress(), value), std::bad_alloc);
 }
