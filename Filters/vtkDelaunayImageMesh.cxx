@@ -60,7 +60,7 @@ int vtkDelaunayImageMesh::RequestUpdateExtent(
 int vtkDelaunayImageMesh::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return featuremesh::RunFilter(this, "Delaunay Image Mesh", [&]() -> int {
+  return featuremesh::RunFilter(this, "Delaunay Image Mesh", outputVector, this->FailedAt, this->FailedAtTime, [&]() -> int {
     using namespace featuremesh;
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();

@@ -62,6 +62,9 @@ protected:
   double MinDihedralAngle;
 
 private:
+  // The pipeline state of the last failed run (0: none), so that it is not repeated.
+  vtkMTimeType FailedAt = 0;
+  double FailedAtTime = 0.0;
   vtkDelaunayImageMesh(const vtkDelaunayImageMesh&) = delete;
   void operator=(const vtkDelaunayImageMesh&) = delete;
 };

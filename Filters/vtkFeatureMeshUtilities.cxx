@@ -19,6 +19,7 @@
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkDemandDrivenPipeline.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkPointData.h"
 #include "vtkSMPTools.h"
@@ -76,6 +77,20 @@ int ReportException(vtkAlgorithm* algorithm, const char* filter, const std::exce
     vtkErrorWithObjectMacro(algorithm, << filter << ": an unknown error.");
   }
   return 0;
+}
+
+RunState PipelineState(vtkAlgorithm* algorithm, vtkInformationVector* outputVector)
+{
+  // Not the inputs' times: the pipeline regenerates and touches them on every pass.
+  RunState state;
+  vtkDemandDrivenPipeline* executive = vtkDemandDrivenPipeline::SafeDownCast(algorithm->GetExecutive());
+  state.Modified = executive ? std::max(executive->GetPipelineMTime(), algorithm->GetMTime()) : algorithm->GetMTime();
+  vtkInformation* info = outputVector->GetInformationObject(0);
+  if (info && info->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
+  {
+    state.TimeStep = info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+  }
+  return state;
 }
 
 bool IsEmptyPiece(vtkInformationVector* outputVector, vtkDataObject* input)
@@ -364,6 +379,14 @@ void RequestWholeImage(vtkInformationVector* portVector)
 
 namespace
 {
+// Values beyond these are refused: float's range for stage 1's float arithmetic, and magnitudes
+// whose squares and sums stay finite for the double arithmetic of stages 2 and 4.
+template <typename T>
+constexpr double LargestValue()
+{
+  return sizeof(T) == sizeof(float) ? 3.4028234663852886e38 : 1e150;
+}
+
 template <typename T>
 bool ToValues(vtkDataArray* array, std::vector<T>& values, std::string& error)
 {
@@ -393,7 +416,7 @@ bool ToValues(vtkDataArray* array, std::vector<T>& values, std::string& error)
         for (vtkIdType i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
         {
           const double v = static_cast<double>(data[i]);
-          const bool ok = std::isfinite(v);
+          const bool ok = std::isfinite(v) && std::fabs(v) <= LargestValue<T>();
           bad += ok ? 0 : 1;
           out[i] = ok ? static_cast<T>(v) : T(0);
         }
@@ -416,7 +439,8 @@ bool ToValues(vtkDataArray* array, std::vector<T>& values, std::string& error)
   if (bad)
   {
     error = std::string("the array '") + (array->GetName() ? array->GetName() : "") + "' holds " +
-      std::to_string(bad) + " NaN or infinite values; replace them (e.g. with a Calculator) first.";
+      std::to_string(bad) + " values that are NaN, infinite or beyond +-" +
+      (sizeof(T) == sizeof(float) ? "3.4e38" : "1e150") + "; replace or rescale them (e.g. with a Calculator) first.";
     return false;
   }
   return true;

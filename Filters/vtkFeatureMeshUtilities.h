@@ -31,26 +31,52 @@ namespace featuremesh
 // failure); returns 0.
 int ReportException(vtkAlgorithm* algorithm, const char* filter, const std::exception_ptr& error);
 
+// What a run depends on: the newest modification of the filter or of anything upstream, and the
+// requested time step (a time series changes the data, not the modification times).
+struct RunState
+{
+  vtkMTimeType Modified = 0;
+  double TimeStep = 0.0;
+  bool operator==(const RunState& other) const
+  {
+    return this->Modified == other.Modified && this->TimeStep == other.TimeStep;
+  }
+};
+RunState PipelineState(vtkAlgorithm* algorithm, vtkInformationVector* outputVector);
+
 // Runs a filter's body (returning int): on the STDThread SMP backend when VTK runs its Sequential
 // default and the user chose none with VTK_SMP_BACKEND_IN_USE (the host's backend is left as it
-// was), and with every exception caught at the VTK boundary.
+// was), and with every exception caught at the VTK boundary. A failure is not run (and reported)
+// again until the filter or its inputs change: ParaView updates every output port, and a failed
+// run leaves them all out of date. `failedAt` and `failedAtTime` are the filter's record of it.
 template <typename Body>
-int RunFilter(vtkAlgorithm* algorithm, const char* filter, Body&& body)
+int RunFilter(vtkAlgorithm* algorithm, const char* filter, vtkInformationVector* outputVector,
+  vtkMTimeType& failedAt, double& failedAtTime, Body&& body)
 {
+  const RunState state = PipelineState(algorithm, outputVector);
+  if (failedAt && state == RunState{ failedAt, failedAtTime })
+  {
+    return 0;
+  }
+  int result = 0;
   try
   {
     if (std::getenv("VTK_SMP_BACKEND_IN_USE") || std::string(vtkSMPTools::GetBackend()) != "Sequential")
     {
-      return body();
+      result = body();
     }
-    int result = 0;
-    vtkSMPTools::LocalScope(vtkSMPTools::Config(std::string("STDThread")), [&]() { result = body(); });
-    return result;
+    else
+    {
+      vtkSMPTools::LocalScope(vtkSMPTools::Config(std::string("STDThread")), [&]() { result = body(); });
+    }
   }
   catch (...)
   {
-    return ReportException(algorithm, filter, std::current_exception());
+    result = ReportException(algorithm, filter, std::current_exception());
   }
+  failedAt = result ? 0 : state.Modified;
+  failedAtTime = state.TimeStep;
+  return result;
 }
 
 // True on a parallel process that holds no piece of the data: the input is empty and this is not

@@ -87,7 +87,7 @@ int vtkFeatureNodes::RequestUpdateExtent(
 int vtkFeatureNodes::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return featuremesh::RunFilter(this, "Feature Nodes", [&]() { return this->Execute(inputVector, outputVector); });
+  return featuremesh::RunFilter(this, "Feature Nodes", outputVector, this->FailedAt, this->FailedAtTime, [&]() { return this->Execute(inputVector, outputVector); });
 }
 
 int vtkFeatureNodes::Execute(vtkInformationVector** inputVector, vtkInformationVector* outputVector)

@@ -102,6 +102,9 @@ protected:
   int BoundarySpacing;
 
 private:
+  // The pipeline state of the last failed run (0: none), so that it is not repeated.
+  vtkMTimeType FailedAt = 0;
+  double FailedAtTime = 0.0;
   vtkFeatureNodes(const vtkFeatureNodes&) = delete;
   void operator=(const vtkFeatureNodes&) = delete;
 };

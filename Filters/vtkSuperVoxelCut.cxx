@@ -87,7 +87,7 @@ int vtkSuperVoxelCut::RequestUpdateExtent(
 int vtkSuperVoxelCut::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return featuremesh::RunFilter(this, "Super-Voxel Cut", [&]() -> int {
+  return featuremesh::RunFilter(this, "Super-Voxel Cut", outputVector, this->FailedAt, this->FailedAtTime, [&]() -> int {
     using namespace featuremesh;
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
@@ -155,10 +155,19 @@ int vtkSuperVoxelCut::RequestData(
     }
     const vtkIdType nCells = input->GetNumberOfCells();
     std::vector<double> mean(nCells), count(nCells);
+    vtkIdType badMean = 0, badCount = 0;
     for (vtkIdType c = 0; c < nCells; ++c)
     {
       mean[c] = meanArray->GetComponent(c, 0);
       count[c] = countArray->GetComponent(c, 0);
+      badMean += std::isfinite(mean[c]) ? 0 : 1;
+      badCount += std::isfinite(count[c]) && count[c] >= 0 ? 0 : 1;
+    }
+    if (badMean || badCount)
+    {
+      return fail("the mesh's " + std::string(badMean ? "MeanIntensity" : "PixelCount") + " cell array holds " +
+        std::to_string(badMean ? badMean : badCount) +
+        (badMean ? " NaN or infinite values" : " negative or non-finite values") + "; recompute the mesh with Delaunay Image Mesh.");
     }
     std::vector<double> values;
     if (image)

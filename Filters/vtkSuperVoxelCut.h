@@ -62,6 +62,9 @@ protected:
   bool VoxelRegionTerm;
 
 private:
+  // The pipeline state of the last failed run (0: none), so that it is not repeated.
+  vtkMTimeType FailedAt = 0;
+  double FailedAtTime = 0.0;
   vtkSuperVoxelCut(const vtkSuperVoxelCut&) = delete;
   void operator=(const vtkSuperVoxelCut&) = delete;
 };

@@ -59,7 +59,7 @@ int vtkVoxelCut::RequestUpdateExtent(vtkInformation*, vtkInformationVector** inp
 
 int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return featuremesh::RunFilter(this, "Voxel Cut", [&]() -> int {
+  return featuremesh::RunFilter(this, "Voxel Cut", outputVector, this->FailedAt, this->FailedAtTime, [&]() -> int {
     using namespace featuremesh;
     const auto start = std::chrono::steady_clock::now();
     vtkImageData* image = vtkImageData::GetData(inputVector[0], 0);

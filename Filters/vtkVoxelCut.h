@@ -53,6 +53,9 @@ protected:
   double SeedRadius;
 
 private:
+  // The pipeline state of the last failed run (0: none), so that it is not repeated.
+  vtkMTimeType FailedAt = 0;
+  double FailedAtTime = 0.0;
   vtkVoxelCut(const vtkVoxelCut&) = delete;
   void operator=(const vtkVoxelCut&) = delete;
 };

@@ -149,7 +149,8 @@ bool SeedVoxels(const std::vector<std::array<double, 3>>& world, const ImageGeom
   }
   if (outside)
   {
-    error = std::to_string(outside) + " of " + std::to_string(world.size()) + " " + what + " seeds fall outside the image.";
+    error = std::to_string(outside) + " of " + std::to_string(world.size()) + " " + what +
+      " seeds fall outside the image (or are not finite).";
     return false;
   }
   return true;

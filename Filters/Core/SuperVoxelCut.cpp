@@ -81,11 +81,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<dou
     return result;
   }
   pr.Value = mean;
-  pr.Size.resize(m);
-  for (std::int64_t c = 0; c < m; ++c)
-  {
-    pr.Size[c] = std::max(0.0, voxelCount[c]);
-  }
+  pr.Size = voxelCount;
   const FaceAdjacency& adj = mesh.Faces();
   pr.A = adj.A;
   pr.B = adj.B;

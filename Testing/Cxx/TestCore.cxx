@@ -472,7 +472,7 @@ TEST(ImageGeometry, OrientedFrameRoundTrips)
   std::vector<std::int64_t> voxels;
   std::string error;
   EXPECT_FALSE(SeedVoxels({ g.IndexToWorld({ { 1, 1, 1 } }), { { 1e9, 0, 0 } } }, g, "object", voxels, error));
-  EXPECT_EQ(error, "1 of 2 object seeds fall outside the image.");
+  EXPECT_EQ(error, "1 of 2 object seeds fall outside the image (or are not finite).");
   EXPECT_FALSE(SeedVoxels({}, g, "background", voxels, error));
   ImageGeometry m = g;
   m.Spacing[1] = -2.0;

@@ -1,0 +1,922 @@
+// The bad-input matrix: every filter on empty, degenerate, non-finite, extreme, oriented and
+// malformed inputs and absurd properties. Each case asserts its outcome: a clear error naming the
+// problem and an empty output, or a correct result. ctest runs every case in its own process with
+// a time limit, so a crash or a hang fails one case, not the suite.
+#include "vtkDelaunayImageMesh.h"
+#include "vtkFeatureNodes.h"
+#include "vtkSuperVoxelCut.h"
+#include "vtkVoxelCut.h"
+
+#include "vtkCellArray.h"
+#include "vtkCellData.h"
+#include "vtkCommand.h"
+#include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkExecutive.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkIdList.h"
+#include "vtkImageData.h"
+#include "vtkMatrix3x3.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
+#include "vtkTypeTraits.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkUnstructuredGrid.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <functional>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace
+{
+using Point = std::array<double, 3>;
+
+// Collects the errors and warnings a filter reports (and keeps them off the console).
+class Messages : public vtkCommand
+{
+public:
+  static Messages* New() { return new Messages; }
+  void Execute(vtkObject*, unsigned long event, void* data) override
+  {
+    (event == vtkCommand::ErrorEvent ? this->Errors : this->Warnings).push_back(static_cast<const char*>(data));
+    if (std::getenv("FEATUREMESH_SHOW_MESSAGES"))
+    {
+      std::cout << (event == vtkCommand::ErrorEvent ? "error: " : "warning: ") << static_cast<const char*>(data);
+    }
+  }
+  std::string All() const
+  {
+    std::string all;
+    for (const auto& e : this->Errors)
+      all += e + " | ";
+    return all;
+  }
+  std::vector<std::string> Errors, Warnings;
+};
+
+template <typename Filter>
+struct Run
+{
+  vtkNew<Filter> F;
+  vtkNew<Messages> Log;
+  Run()
+  {
+    this->F->AddObserver(vtkCommand::ErrorEvent, this->Log);
+    this->F->AddObserver(vtkCommand::WarningEvent, this->Log);
+    this->F->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, this->Log);
+  }
+  Filter* operator->() { return this->F.GetPointer(); }
+  void Update() { this->F->Update(); }
+  bool HasError(const std::string& words) const
+  {
+    for (const auto& e : this->Log->Errors)
+      if (e.find(words) != std::string::npos)
+        return true;
+    return false;
+  }
+};
+
+using Fill = std::function<double(int, int, int)>;
+
+vtkSmartPointer<vtkImageData> Image(std::array<int, 3> dims, const Fill& fill, int type = VTK_FLOAT, int components = 1)
+{
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(dims.data());
+  vtkSmartPointer<vtkDataArray> a = vtkSmartPointer<vtkDataArray>::Take(vtkDataArray::CreateDataArray(type));
+  a->SetName("values");
+  a->SetNumberOfComponents(components);
+  a->SetNumberOfTuples(static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2]);
+  vtkIdType t = 0;
+  for (int k = 0; k < dims[2]; ++k)
+    for (int j = 0; j < dims[1]; ++j)
+      for (int i = 0; i < dims[0]; ++i, ++t)
+        for (int c = 0; c < components; ++c)
+          a->SetComponent(t, c, fill(i, j, k));
+  image->GetPointData()->SetScalars(a);
+  return image;
+}
+
+// The two base inputs: a noisy 64^2 disc and a noisy 40^3 ball (values ~ 20 background, 100 object).
+Fill Noisy(double cx, double cy, double cz, double r)
+{
+  return [=](int i, int j, int k) {
+    const unsigned h = static_cast<unsigned>(i * 73856093) ^ static_cast<unsigned>(j * 19349663) ^ static_cast<unsigned>(k * 83492791);
+    const double noise = static_cast<double>(h % 1000) / 100.0 - 5.0;
+    return (std::hypot(i - cx, j - cy, k - cz) <= r ? 100.0 : 20.0) + noise;
+  };
+}
+vtkSmartPointer<vtkImageData> Disc(int type = VTK_FLOAT)
+{
+  return Image({ { 64, 64, 1 } }, Noisy(31.5, 30.0, 0.0, 16.0), type);
+}
+vtkSmartPointer<vtkImageData> Ball()
+{
+  return Image({ { 40, 40, 40 } }, Noisy(19.5, 20.0, 19.0, 11.0));
+}
+
+vtkSmartPointer<vtkPolyData> Points(const std::vector<Point>& p)
+{
+  auto poly = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  for (const auto& x : p)
+    pts->InsertNextPoint(x.data());
+  poly->SetPoints(pts);
+  return poly;
+}
+
+// World position of a voxel index of an image.
+Point World(vtkImageData* image, double i, double j, double k)
+{
+  Point w;
+  image->TransformContinuousIndexToPhysicalPoint(i, j, k, w.data());
+  return w;
+}
+
+template <typename T>
+vtkSmartPointer<T> Copy(T* data)
+{
+  auto copy = vtkSmartPointer<T>::New();
+  copy->DeepCopy(data);
+  return copy;
+}
+
+vtkSmartPointer<vtkPolyData> NodesOf(vtkImageData* image)
+{
+  Run<vtkFeatureNodes> nodes;
+  nodes->SetInputData(image);
+  nodes.Update();
+  EXPECT_TRUE(nodes.Log->Errors.empty()) << nodes.Log->All();
+  return Copy(nodes->GetOutput());
+}
+
+vtkSmartPointer<vtkUnstructuredGrid> MeshOf(vtkImageData* image, int backend = 0)
+{
+  Run<vtkDelaunayImageMesh> mesh;
+  mesh->SetInputData(0, NodesOf(image));
+  mesh->SetInputData(1, image);
+  mesh->SetBackend(backend);
+  mesh.Update();
+  EXPECT_TRUE(mesh.Log->Errors.empty()) << mesh.Log->All();
+  return Copy(mesh->GetOutput());
+}
+
+// Seeds: in the disc / ball centre, and near a corner.
+vtkSmartPointer<vtkPolyData> ObjectSeeds(vtkImageData* image)
+{
+  const bool is2D = image->GetDimensions()[2] == 1;
+  return Points({ World(image, 31, 30, is2D ? 0 : 19), World(image, 33, 31, is2D ? 0 : 20) });
+}
+vtkSmartPointer<vtkPolyData> BackgroundSeeds(vtkImageData* image)
+{
+  const bool is2D = image->GetDimensions()[2] == 1;
+  return Points({ World(image, 3, 3, is2D ? 0 : 3), World(image, 5, 58 * (is2D ? 1 : 0) + 3, is2D ? 0 : 30) });
+}
+
+struct CutOutputs
+{
+  vtkSmartPointer<vtkUnstructuredGrid> Mesh;
+  vtkSmartPointer<vtkImageData> Labels;
+};
+
+// Runs the Super-Voxel Cut; `image` may be null (then the mesh's field data give the grid).
+template <typename Check>
+void SuperVoxelCut(vtkUnstructuredGrid* mesh, vtkPointSet* object, vtkPointSet* background, vtkImageData* image,
+  const Check& check, const std::function<void(vtkSuperVoxelCut*)>& set = nullptr)
+{
+  Run<vtkSuperVoxelCut> cut;
+  cut->SetInputData(0, mesh);
+  cut->SetInputData(1, object);
+  cut->SetInputData(2, background);
+  if (image)
+    cut->SetInputData(3, image);
+  if (set)
+    set(cut.F);
+  cut.Update();
+  check(cut, CutOutputs{ cut->GetOutput(), vtkImageData::SafeDownCast(cut->GetOutputDataObject(2)) });
+}
+
+void ExpectCutError(Run<vtkSuperVoxelCut>& cut, const CutOutputs& out, const std::string& words)
+{
+  EXPECT_TRUE(cut.HasError(words)) << "wanted an error with '" << words << "', got: " << cut.Log->All();
+  EXPECT_EQ(out.Mesh->GetNumberOfCells(), 0);
+}
+
+// A correct cut: no error, labels of both kinds, every seed's element keeps its seed's label.
+void ExpectGoodCut(Run<vtkSuperVoxelCut>& cut, const CutOutputs& out, vtkImageData* image, vtkPointSet* object,
+  vtkPointSet* background)
+{
+  ASSERT_TRUE(cut.Log->Errors.empty()) << cut.Log->All();
+  vtkDataArray* label = out.Mesh->GetCellData()->GetArray("Label");
+  ASSERT_NE(label, nullptr);
+  double object_ = 0;
+  for (vtkIdType c = 0; c < label->GetNumberOfTuples(); ++c)
+    object_ += label->GetComponent(c, 0);
+  EXPECT_GT(object_, 0);
+  EXPECT_LT(object_, label->GetNumberOfTuples());
+  vtkDataArray* voxels = out.Labels->GetPointData()->GetScalars();
+  for (auto [seeds, want] : { std::pair<vtkPointSet*, int>{ object, 1 }, { background, 0 } })
+    for (vtkIdType s = 0; s < seeds->GetNumberOfPoints(); ++s)
+    {
+      double x[3], ijk[3];
+      seeds->GetPoint(s, x);
+      image->TransformPhysicalPointToContinuousIndex(x, ijk);
+      int dims[3];
+      image->GetDimensions(dims);
+      const vtkIdType v = (static_cast<vtkIdType>(std::lround(ijk[2])) * dims[1] + std::lround(ijk[1])) * dims[0] + std::lround(ijk[0]);
+      EXPECT_EQ(voxels->GetComponent(v, 0), want) << "seed " << s;
+    }
+}
+
+template <typename Filter>
+void ExpectError(Run<Filter>& run, const std::string& words, vtkDataObject* output)
+{
+  EXPECT_TRUE(run.HasError(words)) << "wanted an error with '" << words << "', got: " << run.Log->All();
+  vtkDataSet* ds = vtkDataSet::SafeDownCast(output);
+  EXPECT_TRUE(!ds || ds->GetNumberOfPoints() == 0) << "the output is not empty";
+}
+
+// Feature Nodes on `image`; `check` sees the run and the nodes.
+template <typename Check>
+void FeatureNodes(vtkImageData* image, const Check& check, const std::function<void(vtkFeatureNodes*)>& set = nullptr,
+  vtkImageData* edgeMap = nullptr)
+{
+  Run<vtkFeatureNodes> nodes;
+  nodes->SetInputData(0, image);
+  if (edgeMap)
+    nodes->SetInputData(1, edgeMap);
+  if (set)
+    set(nodes.F);
+  nodes.Update();
+  check(nodes, nodes->GetOutput());
+}
+
+void ExpectNodesInside(Run<vtkFeatureNodes>& run, vtkPolyData* nodes, vtkImageData* image, vtkIdType atLeast = 4)
+{
+  ASSERT_TRUE(run.Log->Errors.empty()) << run.Log->All();
+  EXPECT_GE(nodes->GetNumberOfPoints(), atLeast);
+  int dims[3];
+  image->GetDimensions(dims);
+  const int* ext = image->GetExtent();
+  for (vtkIdType i = 0; i < nodes->GetNumberOfPoints(); ++i)
+  {
+    double x[3], ijk[3];
+    nodes->GetPoint(i, x);
+    image->TransformPhysicalPointToContinuousIndex(x, ijk);
+    for (int a = 0; a < 3; ++a)
+    {
+      ASSERT_NEAR(ijk[a], std::round(ijk[a]), 1e-6) << "node " << i << " is not on a voxel centre";
+      ASSERT_GE(std::round(ijk[a]), ext[2 * a]);
+      ASSERT_LE(std::round(ijk[a]), ext[2 * a + 1]);
+    }
+  }
+}
+
+template <typename Check>
+void DelaunayMesh(vtkPointSet* nodes, vtkImageData* image, const Check& check,
+  const std::function<void(vtkDelaunayImageMesh*)>& set = nullptr)
+{
+  Run<vtkDelaunayImageMesh> mesh;
+  mesh->SetInputData(0, nodes);
+  mesh->SetInputData(1, image);
+  if (set)
+    set(mesh.F);
+  mesh.Update();
+  check(mesh, mesh->GetOutput());
+}
+
+// A correct image mesh: PixelCount sums to the voxels, every element has positive measure in the
+// image's index space.
+void ExpectTiling(Run<vtkDelaunayImageMesh>& run, vtkUnstructuredGrid* mesh, vtkImageData* image)
+{
+  ASSERT_TRUE(run.Log->Errors.empty()) << run.Log->All();
+  ASSERT_GT(mesh->GetNumberOfCells(), 0);
+  vtkDataArray* count = mesh->GetCellData()->GetArray("PixelCount");
+  ASSERT_NE(count, nullptr);
+  double total = 0;
+  for (vtkIdType c = 0; c < count->GetNumberOfTuples(); ++c)
+    total += count->GetComponent(c, 0);
+  EXPECT_EQ(total, static_cast<double>(image->GetNumberOfPoints()));
+}
+
+template <typename Check>
+void VoxelCut(vtkImageData* image, vtkPointSet* object, vtkPointSet* background, const Check& check,
+  const std::function<void(vtkVoxelCut*)>& set = nullptr)
+{
+  Run<vtkVoxelCut> cut;
+  cut->SetInputData(0, image);
+  cut->SetInputData(1, object);
+  cut->SetInputData(2, background);
+  if (set)
+    set(cut.F);
+  cut.Update();
+  check(cut, cut->GetOutput());
+}
+
+void ExpectGoodVoxelCut(Run<vtkVoxelCut>& run, vtkImageData* labels)
+{
+  ASSERT_TRUE(run.Log->Errors.empty()) << run.Log->All();
+  vtkDataArray* l = labels->GetPointData()->GetScalars();
+  ASSERT_NE(l, nullptr);
+  double object = 0;
+  for (vtkIdType v = 0; v < l->GetNumberOfTuples(); ++v)
+    object += l->GetComponent(v, 0);
+  EXPECT_GT(object, 0);
+  EXPECT_LT(object, l->GetNumberOfTuples());
+}
+
+const double NaN = std::numeric_limits<double>::quiet_NaN();
+const double Inf = std::numeric_limits<double>::infinity();
+} // namespace
+
+//------------------------------------------------------------------------------------------------
+// Feature Nodes: images.
+TEST(FeatureNodes, EmptyImage)
+{
+  vtkNew<vtkImageData> empty;
+  FeatureNodes(empty, [](auto& run, vtkPolyData* out) { ExpectError(run, "empty", out); });
+}
+TEST(FeatureNodes, OneVoxel)
+{
+  auto image = Image({ { 1, 1, 1 } }, [](int, int, int) { return 1.0; });
+  FeatureNodes(image, [](auto& run, vtkPolyData* out) { ExpectError(run, "at least 2 voxels", out); });
+}
+TEST(FeatureNodes, OneByN)
+{
+  auto image = Image({ { 1, 50, 1 } }, [](int, int j, int) { return j; });
+  FeatureNodes(image, [](auto& run, vtkPolyData* out) { ExpectError(run, "at least 2 voxels", out); });
+}
+TEST(FeatureNodes, NByOneByN)
+{
+  auto image = Image({ { 30, 1, 30 } }, [](int i, int, int) { return i; });
+  FeatureNodes(image, [](auto& run, vtkPolyData* out) { ExpectError(run, "at least 2 voxels", out); });
+}
+TEST(FeatureNodes, TwoByTwo)
+{
+  auto image = Image({ { 2, 2, 1 } }, [](int i, int j, int) { return i + j; });
+  FeatureNodes(image, [&](auto& run, vtkPolyData* out) { ExpectNodesInside(run, out, image, 4); });
+}
+TEST(FeatureNodes, NaN)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int i, int j, int) { return i == 5 && j == 7 ? NaN : 1.0 * i; });
+  FeatureNodes(image, [](auto& run, vtkPolyData* out) { ExpectError(run, "NaN", out); });
+}
+TEST(FeatureNodes, Infinity)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int i, int, int) { return i == 3 ? -Inf : 1.0 * i; }, VTK_DOUBLE);
+  FeatureNodes(image, [](auto& run, vtkPolyData* out) { ExpectError(run, "infinite", out); });
+}
+TEST(FeatureNodes, StepsNearTheFloatLimit)
+{
+  auto image = Image({ { 64, 64, 1 } }, [](int i, int j, int) { return std::hypot(i - 31.5, j - 30) < 16 ? 3e38 : -3e38; });
+  FeatureNodes(image, [&](auto& run, vtkPolyData* out) { ExpectNodesInside(run, out, image, 20); });
+}
+TEST(FeatureNodes, DenormalValues)
+{
+  auto image = Image({ { 64, 64, 1 } }, [](int i, int j, int) { return std::hypot(i - 31.5, j - 30) < 16 ? 1e-39 : 1e-41; });
+  FeatureNodes(image, [&](auto& run, vtkPolyData* out) { ExpectNodesInside(run, out, image, 20); });
+}
+TEST(FeatureNodes, DoublesBeyondTheFloatRange)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int i, int, int) { return i < 16 ? 1e300 : -1e300; }, VTK_DOUBLE);
+  FeatureNodes(image, [](auto& run, vtkPolyData* out) { ExpectError(run, "beyond", out); });
+}
+TEST(FeatureNodes, DoublesNearTheDoubleLimit)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int i, int, int) { return i < 16 ? 1.7e308 : 0.0; }, VTK_DOUBLE);
+  FeatureNodes(image, [](auto& run, vtkPolyData* out) { ExpectError(run, "beyond", out); });
+}
+
+// Every VTK scalar type.
+class ScalarType : public ::testing::TestWithParam<int>
+{
+};
+TEST_P(ScalarType, DiscGivesNodes)
+{
+  auto image = Image({ { 64, 64, 1 } }, [](int i, int j, int) { return std::hypot(i - 31.5, j - 30) < 16 ? 100 : 20; }, GetParam());
+  FeatureNodes(image, [&](auto& run, vtkPolyData* out) { ExpectNodesInside(run, out, image, 20); });
+}
+INSTANTIATE_TEST_SUITE_P(FeatureNodes, ScalarType,
+  ::testing::Values(VTK_CHAR, VTK_SIGNED_CHAR, VTK_UNSIGNED_CHAR, VTK_SHORT, VTK_UNSIGNED_SHORT, VTK_INT,
+    VTK_UNSIGNED_INT, VTK_LONG, VTK_UNSIGNED_LONG, VTK_LONG_LONG, VTK_UNSIGNED_LONG_LONG, VTK_FLOAT, VTK_DOUBLE,
+    VTK_ID_TYPE));
+
+TEST(FeatureNodes, TwoComponents)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int i, int, int) { return i; }, VTK_FLOAT, 2);
+  FeatureNodes(image, [](auto& run, vtkPolyData* out) { ExpectError(run, "components", out); });
+}
+TEST(FeatureNodes, ThreeComponents)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int i, int, int) { return i; }, VTK_UNSIGNED_CHAR, 3);
+  FeatureNodes(image, [](auto& run, vtkPolyData* out) { ExpectError(run, "components", out); });
+}
+TEST(FeatureNodes, NoScalars)
+{
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(16, 16, 1);
+  FeatureNodes(image, [](auto& run, vtkPolyData* out) { ExpectError(run, "scalars", out); });
+}
+TEST(FeatureNodes, NegativeSpacing)
+{
+  auto image = Disc();
+  image->SetSpacing(1.0, -0.5, 1.0);
+  FeatureNodes(image, [&](auto& run, vtkPolyData* out) { ExpectNodesInside(run, out, image, 20); });
+}
+TEST(FeatureNodes, ZeroSpacing)
+{
+  auto image = Disc();
+  image->SetSpacing(1.0, 0.0, 1.0);
+  FeatureNodes(image, [](auto& run, vtkPolyData* out) { ExpectError(run, "spacing", out); });
+}
+TEST(FeatureNodes, AnisotropicSpacingRotatedDirectionAndOrigin)
+{
+  auto image = Ball();
+  image->SetSpacing(0.5, 1.5, 3.0);
+  image->SetOrigin(-100, 20, 7.5);
+  const double c = std::cos(0.4), s = std::sin(0.4);
+  const double direction[9] = { c, -s, 0, s, c, 0, 0, 0, 1 };
+  image->SetDirectionMatrix(direction);
+  FeatureNodes(image, [&](auto& run, vtkPolyData* out) { ExpectNodesInside(run, out, image, 50); });
+}
+TEST(FeatureNodes, SingularDirection)
+{
+  auto image = Disc();
+  const double direction[9] = { 1, 0, 0, 1, 0, 0, 0, 0, 1 };
+  image->SetDirectionMatrix(direction);
+  FeatureNodes(image, [](auto& run, vtkPolyData* out) { ExpectError(run, "direction", out); });
+}
+TEST(FeatureNodes, ExtentNotStartingAtZero)
+{
+  auto image = Disc();
+  image->SetExtent(10, 73, -5, 58, 3, 3);
+  FeatureNodes(image, [&](auto& run, vtkPolyData* out) { ExpectNodesInside(run, out, image, 20); });
+}
+TEST(FeatureNodes, ConstantImageWarns)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int, int, int) { return 7.0; });
+  FeatureNodes(image, [&](auto& run, vtkPolyData* out) {
+    ExpectNodesInside(run, out, image, 4);
+    ASSERT_FALSE(run.Log->Warnings.empty());
+    EXPECT_NE(run.Log->Warnings[0].find("no edges"), std::string::npos);
+  });
+}
+TEST(FeatureNodes, NegativeSigma)
+{
+  FeatureNodes(Disc(), [](auto& run, vtkPolyData* out) { ExpectError(run, "sigma", out); },
+    [](vtkFeatureNodes* f) { f->SetGaussianSigma(-1); });
+}
+TEST(FeatureNodes, ThresholdsOutOfOrder)
+{
+  FeatureNodes(Disc(), [](auto& run, vtkPolyData* out) { ExpectError(run, "threshold", out); },
+    [](vtkFeatureNodes* f) {
+      f->SetLowThreshold(0.8);
+      f->SetHighThreshold(0.2);
+    });
+}
+TEST(FeatureNodes, SigmaWiderThanTheImage)
+{
+  auto image = Disc();
+  FeatureNodes(image, [&](auto& run, vtkPolyData* out) { ExpectNodesInside(run, out, image, 4); },
+    [](vtkFeatureNodes* f) { f->SetGaussianSigma(40); });
+}
+TEST(FeatureNodes, ZeroSpacingOfNodes)
+{
+  FeatureNodes(Disc(), [](auto& run, vtkPolyData* out) { ExpectError(run, "spacing", out); },
+    [](vtkFeatureNodes* f) { f->SetUniformSpacing(0); });
+}
+TEST(FeatureNodes, DenseNodeBudget)
+{
+  auto image = Disc();
+  FeatureNodes(image, [&](auto& run, vtkPolyData* out) { ExpectNodesInside(run, out, image, 64 * 64 / 2); },
+    [](vtkFeatureNodes* f) {
+      f->SetUniformSpacing(1);
+      f->SetBoundarySpacing(1);
+      f->SetExclusionWindow(1);
+    });
+}
+TEST(FeatureNodes, EdgeMapOnAnotherGrid)
+{
+  auto edges = Image({ { 10, 10, 1 } }, [](int, int, int) { return 1; }, VTK_UNSIGNED_CHAR);
+  FeatureNodes(Disc(), [](auto& run, vtkPolyData* out) { ExpectError(run, "same grid", out); }, nullptr, edges);
+}
+TEST(FeatureNodes, EdgeMapEverywhere)
+{
+  auto image = Disc();
+  auto edges = Image({ { 64, 64, 1 } }, [](int, int, int) { return 1; }, VTK_UNSIGNED_CHAR);
+  FeatureNodes(image, [&](auto& run, vtkPolyData* out) { ExpectNodesInside(run, out, image, 20); }, nullptr, edges);
+}
+
+//------------------------------------------------------------------------------------------------
+// Delaunay Image Mesh: nodes and images.
+TEST(DelaunayImageMesh, NoNodes)
+{
+  DelaunayMesh(Points({}), Disc(), [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "too few", out); });
+}
+TEST(DelaunayImageMesh, ThreeNodesIn3D)
+{
+  auto image = Ball();
+  DelaunayMesh(Points({ World(image, 0, 0, 0), World(image, 5, 0, 0), World(image, 0, 5, 0) }), image,
+    [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "too few", out); });
+}
+TEST(DelaunayImageMesh, CollinearNodes)
+{
+  auto image = Disc();
+  DelaunayMesh(Points({ World(image, 0, 0, 0), World(image, 5, 5, 0), World(image, 9, 9, 0) }), image,
+    [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "collinear", out); });
+}
+TEST(DelaunayImageMesh, CoplanarNodes)
+{
+  auto image = Ball();
+  DelaunayMesh(Points({ World(image, 0, 0, 4), World(image, 9, 0, 4), World(image, 0, 9, 4), World(image, 7, 7, 4) }), image,
+    [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "coplanar", out); });
+}
+TEST(DelaunayImageMesh, DuplicatedNodes)
+{
+  auto image = Disc();
+  DelaunayMesh(Points({ World(image, 0, 0, 0), World(image, 9, 0, 0), World(image, 0, 9, 0), World(image, 9, 0, 0) }), image,
+    [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "duplicate", out); });
+}
+TEST(DelaunayImageMesh, NodesOutside)
+{
+  auto image = Disc();
+  DelaunayMesh(Points({ World(image, 0, 0, 0), World(image, 90, 0, 0), World(image, 0, 9, 0) }), image,
+    [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "outside", out); });
+}
+TEST(DelaunayImageMesh, NodesOffVoxelCentres)
+{
+  auto image = Disc();
+  DelaunayMesh(Points({ World(image, 0, 0, 0), World(image, 9.5, 0, 0), World(image, 0, 9.25, 0), World(image, 20, 20, 0) }),
+    image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "voxel centres", out); });
+}
+TEST(DelaunayImageMesh, NodesOffThe2DPlane)
+{
+  auto image = Disc();
+  DelaunayMesh(Points({ World(image, 0, 0, 0), World(image, 9, 0, 0), World(image, 0, 9, 1) }), image,
+    [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "slice plane", out); });
+}
+TEST(DelaunayImageMesh, NaNNode)
+{
+  auto image = Disc();
+  DelaunayMesh(Points({ World(image, 0, 0, 0), World(image, 9, 0, 0), { { NaN, 3, 0 } } }), image,
+    [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "outside", out); });
+}
+TEST(DelaunayImageMesh, ImageWithNaN)
+{
+  auto image = Disc();
+  auto bad = Image({ { 64, 64, 1 } }, [](int i, int, int) { return i == 9 ? NaN : 1.0; });
+  DelaunayMesh(NodesOf(image), bad, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "NaN", out); });
+}
+TEST(DelaunayImageMesh, ImageBeyondDoubleSquares)
+{
+  auto image = Disc();
+  auto huge = Image({ { 64, 64, 1 } }, [](int i, int, int) { return i < 30 ? 1e200 : 0.0; }, VTK_DOUBLE);
+  DelaunayMesh(NodesOf(image), huge, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "beyond", out); });
+}
+TEST(DelaunayImageMesh, OnlyCornersIn3D)
+{
+  auto image = Ball();
+  DelaunayMesh(Points({ World(image, 0, 0, 0), World(image, 39, 0, 0), World(image, 0, 39, 0), World(image, 0, 0, 39) }),
+    image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectTiling(run, out, image); });
+}
+TEST(DelaunayImageMesh, Disc)
+{
+  auto image = Disc();
+  DelaunayMesh(NodesOf(image), image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectTiling(run, out, image); });
+}
+TEST(DelaunayImageMesh, BallWithTetGen)
+{
+  auto image = Ball();
+  DelaunayMesh(NodesOf(image), image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectTiling(run, out, image); });
+}
+TEST(DelaunayImageMesh, BallWithCGAL)
+{
+  auto image = Ball();
+  DelaunayMesh(NodesOf(image), image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectTiling(run, out, image); },
+    [](vtkDelaunayImageMesh* m) { m->SetBackend(vtkDelaunayImageMesh::CGAL); });
+}
+TEST(DelaunayImageMesh, MirroredDirection)
+{
+  auto image = Ball();
+  const double direction[9] = { -1, 0, 0, 0, 1, 0, 0, 0, 1 };
+  image->SetDirectionMatrix(direction);
+  DelaunayMesh(NodesOf(image), image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectTiling(run, out, image); });
+}
+TEST(DelaunayImageMesh, RefinementParametersOutOfRange)
+{
+  auto image = Ball();
+  DelaunayMesh(NodesOf(image), image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "radius-edge", out); },
+    [](vtkDelaunayImageMesh* m) {
+      m->SetQualityRefinement(true);
+      m->SetRadiusEdgeRatio(0.5);
+    });
+}
+
+//------------------------------------------------------------------------------------------------
+// Super-Voxel Cut: meshes, seeds, properties.
+namespace
+{
+struct Case2D
+{
+  vtkSmartPointer<vtkImageData> image = Disc();
+  vtkSmartPointer<vtkUnstructuredGrid> mesh = MeshOf(image);
+  vtkSmartPointer<vtkPolyData> object = ObjectSeeds(image), background = BackgroundSeeds(image);
+};
+} // namespace
+
+TEST(SuperVoxelCut, Disc)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image,
+    [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, c.image, c.object, c.background); });
+}
+TEST(SuperVoxelCut, DiscWithoutTheImage)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, nullptr,
+    [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, c.image, c.object, c.background); });
+}
+TEST(SuperVoxelCut, EmptyMesh)
+{
+  Case2D c;
+  vtkNew<vtkUnstructuredGrid> empty;
+  SuperVoxelCut(empty, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "empty"); });
+}
+TEST(SuperVoxelCut, MeshWithoutMeanIntensity)
+{
+  Case2D c;
+  c.mesh->GetCellData()->RemoveArray("MeanIntensity");
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image,
+    [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "MeanIntensity"); });
+}
+TEST(SuperVoxelCut, MeanIntensityNaNWithoutImage)
+{
+  Case2D c;
+  c.mesh->GetCellData()->GetArray("MeanIntensity")->SetComponent(17, 0, NaN);
+  SuperVoxelCut(c.mesh, c.object, c.background, nullptr,
+    [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "MeanIntensity cell array holds 1 NaN"); });
+}
+TEST(SuperVoxelCut, NegativePixelCountWithoutImage)
+{
+  Case2D c;
+  c.mesh->GetCellData()->GetArray("PixelCount")->SetComponent(3, 0, -5);
+  SuperVoxelCut(c.mesh, c.object, c.background, nullptr,
+    [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "PixelCount cell array holds 1 negative"); });
+}
+TEST(SuperVoxelCut, QuadMesh)
+{
+  Case2D c;
+  vtkNew<vtkUnstructuredGrid> quads;
+  quads->ShallowCopy(c.mesh);
+  vtkNew<vtkCellArray> cells;
+  const vtkIdType q[4] = { 0, 1, 2, 3 };
+  cells->InsertNextCell(4, q);
+  quads->SetCells(VTK_QUAD, cells);
+  quads->GetCellData()->Initialize();
+  quads->GetCellData()->AddArray(c.mesh->GetCellData()->GetArray("MeanIntensity"));
+  quads->GetCellData()->AddArray(c.mesh->GetCellData()->GetArray("PixelCount"));
+  SuperVoxelCut(quads, c.object, c.background, c.image,
+    [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "triangles"); });
+}
+TEST(SuperVoxelCut, MixedCellTypes)
+{
+  Case2D c;
+  vtkNew<vtkUnstructuredGrid> mixed;
+  mixed->DeepCopy(c.mesh);
+  const vtkIdType line[2] = { 0, 1 };
+  mixed->InsertNextCell(VTK_LINE, 2, line);
+  for (const char* name : { "MeanIntensity", "PixelCount" })
+    mixed->GetCellData()->GetArray(name)->InsertNextTuple1(1.0);
+  SuperVoxelCut(mixed, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "mixes"); });
+}
+TEST(SuperVoxelCut, CellIdOutOfRange)
+{
+  Case2D c;
+  vtkNew<vtkUnstructuredGrid> bad;
+  bad->DeepCopy(c.mesh);
+  vtkNew<vtkIdList> ids;
+  bad->GetCellPoints(5, ids);
+  ids->SetId(1, 1000000);
+  bad->ReplaceCell(5, 3, ids->GetPointer(0));
+  SuperVoxelCut(bad, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "outside"); });
+}
+TEST(SuperVoxelCut, ClockwiseMeshGivesTheSameLabels)
+{
+  Case2D c;
+  vtkNew<vtkUnstructuredGrid> clockwise;
+  clockwise->DeepCopy(c.mesh);
+  vtkNew<vtkIdList> ids;
+  for (vtkIdType e = 0; e < clockwise->GetNumberOfCells(); ++e)
+  {
+    clockwise->GetCellPoints(e, ids);
+    const vtkIdType flipped[3] = { ids->GetId(0), ids->GetId(2), ids->GetId(1) };
+    clockwise->ReplaceCell(e, 3, flipped);
+  }
+  std::vector<double> want, got;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [&](auto&, const CutOutputs& out) {
+    for (vtkIdType e = 0; e < out.Mesh->GetNumberOfCells(); ++e)
+      want.push_back(out.Mesh->GetCellData()->GetArray("Label")->GetComponent(e, 0));
+  });
+  SuperVoxelCut(clockwise, c.object, c.background, c.image, [&](auto& cut, const CutOutputs& out) {
+    ExpectGoodCut(cut, out, c.image, c.object, c.background);
+    for (vtkIdType e = 0; e < out.Mesh->GetNumberOfCells(); ++e)
+      got.push_back(out.Mesh->GetCellData()->GetArray("Label")->GetComponent(e, 0));
+  });
+  EXPECT_EQ(want, got);
+}
+TEST(SuperVoxelCut, MeshFromAnotherImage)
+{
+  Case2D c;
+  auto other = Image({ { 70, 64, 1 } }, [](int i, int, int) { return i; });
+  SuperVoxelCut(c.mesh, c.object, c.background, other,
+    [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "another image grid"); });
+}
+TEST(SuperVoxelCut, MeshWithoutFrameOrImage)
+{
+  Case2D c;
+  c.mesh->GetFieldData()->Initialize();
+  SuperVoxelCut(c.mesh, c.object, c.background, nullptr,
+    [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "connect the Image"); });
+}
+TEST(SuperVoxelCut, NoObjectSeeds)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, Points({}), c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "no object seeds"); });
+}
+TEST(SuperVoxelCut, NoBackgroundSeeds)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, Points({}), c.image,
+    [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "no background seeds"); });
+}
+TEST(SuperVoxelCut, SeedsOutside)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, Points({ { { 500, 500, 0 } }, World(c.image, 31, 30, 0) }), c.background, c.image,
+    [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "1 of 2 object seeds fall outside"); });
+}
+TEST(SuperVoxelCut, NaNSeed)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, Points({ { { NaN, 3, 0 } } }), c.image,
+    [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "fall outside"); });
+}
+TEST(SuperVoxelCut, ConflictingSeeds)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.object, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "both"); });
+}
+TEST(SuperVoxelCut, ThousandsOfSeeds)
+{
+  Case2D c;
+  std::vector<Point> inside, outside;
+  for (int j = 0; j < 64; ++j)
+    for (int i = 0; i < 64; ++i)
+    {
+      const double r = std::hypot(i - 31.5, j - 30.0);
+      if (r < 10)
+        inside.push_back(World(c.image, i, j, 0));
+      else if (r > 24)
+        outside.push_back(World(c.image, i, j, 0));
+    }
+  auto object = Points(inside), background = Points(outside);
+  ASSERT_GT(inside.size() + outside.size(), 1500u);
+  SuperVoxelCut(c.mesh, object, background, c.image,
+    [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, c.image, object, background); });
+}
+TEST(SuperVoxelCut, TinySigmaKeepsTheSeeds)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image,
+    [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, c.image, c.object, c.background); },
+    [](vtkSuperVoxelCut* f) { f->SetSigma(1e-300); });
+}
+TEST(SuperVoxelCut, NegativeSigma)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "sigma"); },
+    [](vtkSuperVoxelCut* f) { f->SetSigma(-1); });
+}
+TEST(SuperVoxelCut, BillionBins)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "bin"); },
+    [](vtkSuperVoxelCut* f) { f->SetBins(1000000000); });
+}
+TEST(SuperVoxelCut, HugeLambda)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "lambda"); },
+    [](vtkSuperVoxelCut* f) { f->SetLambda(1e300); });
+}
+TEST(SuperVoxelCut, ZeroLambdaIsBoundaryOnly)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image,
+    [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, c.image, c.object, c.background); },
+    [](vtkSuperVoxelCut* f) { f->SetLambda(0); });
+}
+TEST(SuperVoxelCut, NegativeSpacingIn3DFinishes)
+{
+  auto image = Ball();
+  image->SetSpacing(1.0, -1.0, 2.0);
+  auto mesh = MeshOf(image);
+  auto object = ObjectSeeds(image), background = BackgroundSeeds(image);
+  SuperVoxelCut(mesh, object, background, image,
+    [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, image, object, background); });
+}
+TEST(SuperVoxelCut, MeanIntensityNaNIn3DWithoutImageFinishes)
+{
+  auto image = Ball();
+  auto mesh = MeshOf(image);
+  mesh->GetCellData()->GetArray("MeanIntensity")->SetComponent(0, 0, NaN);
+  SuperVoxelCut(mesh, ObjectSeeds(image), BackgroundSeeds(image), nullptr,
+    [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "NaN"); });
+}
+TEST(SuperVoxelCut, TetGenAndCGALMeshesBothCut)
+{
+  auto image = Ball();
+  auto object = ObjectSeeds(image), background = BackgroundSeeds(image);
+  for (int backend : { 0, 1 })
+    SuperVoxelCut(MeshOf(image, backend), object, background, image,
+      [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, image, object, background); });
+}
+TEST(SuperVoxelCut, TriangleMeshOnA3DImage)
+{
+  Case2D c;
+  auto ball = Ball();
+  SuperVoxelCut(c.mesh, ObjectSeeds(ball), BackgroundSeeds(ball), ball,
+    [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "another image grid"); });
+}
+
+//------------------------------------------------------------------------------------------------
+// Voxel Cut.
+TEST(VoxelCut, Disc)
+{
+  auto image = Disc();
+  VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectGoodVoxelCut(run, out); });
+}
+TEST(VoxelCut, BallWithMirroredSpacing)
+{
+  auto image = Ball();
+  image->SetSpacing(-1.0, 1.0, 1.0);
+  VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectGoodVoxelCut(run, out); });
+}
+TEST(VoxelCut, EmptyImage)
+{
+  vtkNew<vtkImageData> empty;
+  auto image = Disc();
+  VoxelCut(empty, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "empty", out); });
+}
+TEST(VoxelCut, NaNImage)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int i, int, int) { return i == 4 ? NaN : i; });
+  VoxelCut(image, Points({ World(image, 20, 20, 0) }), Points({ World(image, 2, 2, 0) }),
+    [](auto& run, vtkImageData* out) { ExpectError(run, "NaN", out); });
+}
+TEST(VoxelCut, SeedsOutside)
+{
+  auto image = Disc();
+  VoxelCut(image, Points({ { { -40, 0, 0 } } }), BackgroundSeeds(image),
+    [](auto& run, vtkImageData* out) { ExpectError(run, "outside", out); });
+}
+TEST(VoxelCut, ConflictingSeeds)
+{
+  auto image = Disc();
+  VoxelCut(image, ObjectSeeds(image), ObjectSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "both", out); });
+}
+TEST(VoxelCut, TwoComponents)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int i, int, int) { return i; }, VTK_FLOAT, 2);
+  VoxelCut(image, Points({ World(image, 20, 20, 0) }), Points({ World(image, 2, 2, 0) }),
+    [](auto& run, vtkImageData* out) { ExpectError(run, "components", out); });
+}
+TEST(VoxelCut, SeedRadiusOutOfRange)
+{
+  auto image = Disc();
+  VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "seed radius", out); },
+    [](vtkVoxelCut* f) { f->SetSeedRadius(1000); });
+}
+TEST(VoxelCut, TinySigmaKeepsTheSeeds)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int i, int, int) { return i < 16 ? 5.0 : 0.0; });
+  VoxelCut(image, Points({ World(image, 3, 3, 0) }), Points({ World(image, 30, 30, 0) }),
+    [&](auto& run, vtkImageData* out) {
+      ExpectGoodVoxelCut(run, out);
+      EXPECT_EQ(out->GetPointData()->GetScalars()->GetComponent(3 * 32 + 3, 0), 1);
+      EXPECT_EQ(out->GetPointData()->GetScalars()->GetComponent(30 * 32 + 30, 0), 0);
+    },
+    [](vtkVoxelCut* f) { f->SetSigma(1e-300); });
+}
