@@ -108,6 +108,10 @@ void ThrowOutOfMemory(const char* what)
   throw std::runtime_error(std::string("max-flow: ") + what);
 }
 
+// Long loops ask for progress (and abort) every 2^18 steps: a few ms each, ~0.25 s at the worst
+// on fresh memory.
+constexpr std::int64_t CheckEvery = (std::int64_t(1) << 18) - 1;
+
 // Values whose squares and sums stay finite in double precision.
 constexpr double LargestIntensity = 1e150;
 
@@ -121,8 +125,9 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
 {
   const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
   const std::int64_t m = static_cast<std::int64_t>(pr.A.size());
-  if (static_cast<std::int64_t>(pr.Size.size()) != n || static_cast<std::int64_t>(pr.Hard.size()) != n ||
-    static_cast<std::int64_t>(pr.B.size()) != m || static_cast<std::int64_t>(pr.Contact.size()) != m)
+  if ((!pr.Size.empty() && static_cast<std::int64_t>(pr.Size.size()) != n) ||
+    static_cast<std::int64_t>(pr.Hard.size()) != n || static_cast<std::int64_t>(pr.B.size()) != m ||
+    (!pr.Contact.empty() && static_cast<std::int64_t>(pr.Contact.size()) != m))
   {
     return "the graph's arrays disagree in length.";
   }
@@ -130,12 +135,20 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
   for (std::int64_t p = 0; p < n; ++p)
   {
     badValue += Usable(pr.Value[p]) ? 0 : 1;
-    badSize += (std::isfinite(pr.Size[p]) && pr.Size[p] >= 0.0) ? 0 : 1;
+  }
+  for (double size : pr.Size)
+  {
+    badSize += (std::isfinite(size) && size >= 0.0) ? 0 : 1;
   }
   for (std::int64_t e = 0; e < m; ++e)
   {
-    badEdge += (pr.A[e] >= 0 && pr.A[e] < n && pr.B[e] >= 0 && pr.B[e] < n && std::isfinite(pr.Contact[e]) &&
-                 pr.Contact[e] >= 0.0)
+    if ((e & CheckEvery) == CheckEvery && !progress(0.5 * static_cast<double>(e) / static_cast<double>(m)))
+    {
+      aborted = true;
+      return std::string();
+    }
+    badEdge += (pr.A[e] >= 0 && pr.A[e] < n && pr.B[e] >= 0 && pr.B[e] < n &&
+                 (pr.Contact.empty() || (std::isfinite(pr.Contact[e]) && pr.Contact[e] >= 0.0)))
       ? 0
       : 1;
   }
@@ -151,7 +164,7 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
     for (std::int64_t v = 0; v < pr.VoxelTotal; ++v)
     {
       badValue += Usable(pr.VoxelValue[v]) ? 0 : 1;
-      if ((v & 0xFFFFF) == 0xFFFFF && !progress(static_cast<double>(v) / static_cast<double>(pr.VoxelTotal)))
+      if ((v & CheckEvery) == CheckEvery && !progress(static_cast<double>(v) / static_cast<double>(pr.VoxelTotal)))
       {
         aborted = true;
         return std::string();
@@ -195,9 +208,9 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   {
     return r;
   }
-  // Every loop below checks for an abort about every million steps.
+  // Every loop below checks for an abort every CheckEvery + 1 steps.
   auto aborted = [&](std::int64_t i, std::int64_t count, double begin, double end) {
-    if ((i & 0xFFFFF) != 0xFFFFF)
+    if ((i & CheckEvery) != CheckEvery)
     {
       return false;
     }
@@ -265,13 +278,15 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     return r;
   }
 
-  std::vector<double> weight(m);
+  // Not zero-filled: its pages are first touched in the loop below, which reports progress.
+  std::unique_ptr<double[]> weight(new double[m]);
   double total = 1.0;
   for (std::int64_t e = 0; e < m; ++e)
   {
     const double d = pr.Value[pr.A[e]] - pr.Value[pr.B[e]];
     // Equal neighbours have weight 1 whatever sigma (a tiny sigma would give 0 * inf).
-    weight[e] = pr.Contact[e] * (d == 0.0 ? 1.0 : std::exp(-d * d * inv2s2));
+    const double contact = pr.Contact.empty() ? 1.0 : pr.Contact[e];
+    weight[e] = contact * (d == 0.0 ? 1.0 : std::exp(-d * d * inv2s2));
     total += weight[e];
     if (aborted(e, m, 0.1, 0.2))
     {
@@ -283,9 +298,13 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     return r;
   }
   // Region costs of each node: labelled object it pays regionObject, labelled background regionBackground.
-  std::vector<double> regionObject(n), regionBackground(n);
+  // Not zero-filled unless summed into: a 9 M-voxel graph's pages are first touched in loops that
+  // report progress.
+  std::unique_ptr<double[]> regionObject(new double[n]), regionBackground(new double[n]);
   if (exact)
   {
+    std::fill(regionObject.get(), regionObject.get() + n, 0.0);
+    std::fill(regionBackground.get(), regionBackground.get() + n, 0.0);
     for (std::int64_t v = 0; v < pr.VoxelTotal; ++v)
     {
       const std::int64_t p = pr.VoxelOwner[v];
@@ -306,8 +325,13 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     for (std::int64_t p = 0; p < n; ++p)
     {
       const int b = bin(pr.Value[p]);
-      regionObject[p] = pr.Size[p] * costObject[b];
-      regionBackground[p] = pr.Size[p] * costBackground[b];
+      const double size = pr.Size.empty() ? 1.0 : pr.Size[p];
+      regionObject[p] = size * costObject[b];
+      regionBackground[p] = size * costBackground[b];
+      if (aborted(p, n, 0.2, 0.3))
+      {
+        return r;
+      }
     }
   }
   for (std::int64_t p = 0; p < n; ++p)
@@ -315,6 +339,10 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     regionObject[p] *= par.Lambda;
     regionBackground[p] *= par.Lambda;
     total += std::max(regionObject[p], regionBackground[p]);
+    if (aborted(p, n, 0.3, 0.35))
+    {
+      return r;
+    }
   }
   if (phaseAborted(0.35))
   {
@@ -332,9 +360,23 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   try
   {
     g = std::make_shared<G>(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory);
-    g->add_node(static_cast<int>(n));
+    // Nodes in chunks (the same ids as one call): first touching a 9 M-voxel graph's memory takes
+    // seconds, and progress must keep coming.
+    constexpr std::int64_t chunk = std::int64_t(1) << 20;
+    for (std::int64_t p = 0; p < n; p += chunk)
+    {
+      g->add_node(static_cast<int>(std::min(chunk, n - p)));
+      if (phaseAborted(0.35 + 0.05 * static_cast<double>(p) / static_cast<double>(n)))
+      {
+        return r;
+      }
+    }
     for (std::int64_t p = 0; p < n; ++p)
     {
+      if (aborted(p, n, 0.4, 0.45))
+      {
+        return r;
+      }
       if (pr.Hard[p] == 1)
       {
         g->add_tweights(static_cast<int>(p), K, 0.0);
@@ -352,7 +394,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     for (std::int64_t e = 0; e < m; ++e)
     {
       g->add_edge(static_cast<int>(pr.A[e]), static_cast<int>(pr.B[e]), weight[e], weight[e]);
-      if (aborted(e, m, 0.35, 0.5))
+      if (aborted(e, m, 0.45, 0.5))
       {
         return r;
       }

@@ -34,9 +34,9 @@ struct BoykovJollyParameters
 struct CutProblem
 {
   std::vector<double> Value;   // intensity of each node (mean intensity for an element)
-  std::vector<double> Size;    // region-term weight of each node (its voxel count)
+  std::vector<double> Size;    // region-term weight of each node (its voxel count); empty = 1 each
   std::vector<std::int64_t> A, B;
-  std::vector<double> Contact; // per edge, in voxel faces
+  std::vector<double> Contact; // per edge, in voxel faces; empty = 1 each (the voxel grid)
   std::vector<std::uint8_t> Hard; // 0 free, 1 object seed, 2 background seed
   std::vector<double> ObjectSamples, ObjectWeights, BackgroundSamples, BackgroundWeights;
   // Optional exact region term for super-voxels (not owned; both set or both null): node p's region

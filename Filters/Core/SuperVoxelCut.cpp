@@ -197,7 +197,6 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
   };
   gather(objectVoxels, pr.ObjectSamples);
   gather(backgroundVoxels, pr.BackgroundSamples);
-  pr.Size.assign(n, 1.0);
   const std::int64_t sx = 1, sy = g.Dims[0], sz = g.SliceStride();
   const std::int64_t edges = (g.Dims[0] - 1) * std::int64_t(g.Dims[1]) * g.Dims[2] +
     std::int64_t(g.Dims[0]) * (g.Dims[1] - 1) * g.Dims[2] + (g.Is2D() ? 0 : sz * (g.Dims[2] - 1));
@@ -231,7 +230,7 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
         }
       }
   }
-  pr.Contact.assign(pr.A.size(), 1.0);
+  // Size and Contact stay empty: 1 for every voxel and every voxel face.
   return BoykovJollyCut(pr, parameters, SubProgress(progress, 0.1, 1.0));
 }
 } // namespace featuremesh

@@ -1,0 +1,66 @@
+"""Progress and abort on the largest case (BraTS, 240x240x155): every filter reports progress at
+least every 0.5 s; an abort during the max-flow returns within a second with an empty output; the
+aborted filter runs again on the next update and gives its full result."""
+import time
+
+import fmtest as ft
+
+case = ft.fm.Case(ft.case_dir("brain-tumour-brats-0005"))
+MAX_GAP = 0.5
+
+
+def watch(proxy):
+    """Updates the proxy, recording when its VTK object reports progress; returns (gaps, events)."""
+    algorithm = proxy.GetClientSideObject()
+    stamps = []
+    tag = algorithm.AddObserver("ProgressEvent", lambda o, e: stamps.append((time.perf_counter(), o.GetProgress())))
+    start = time.perf_counter()
+    proxy.UpdatePipeline()
+    end = time.perf_counter()
+    algorithm.RemoveObserver(tag)
+    times = [start] + [t for t, _ in stamps] + [end]
+    return max(b - a for a, b in zip(times, times[1:])), len(stamps), end - start
+
+
+nodes = case.feature_nodes()
+mesh = case.mesh(nodes)
+cut = case.super_voxel_cut(mesh)
+for name, proxy in (("Feature Nodes", nodes), ("Delaunay Image Mesh", mesh), ("Super-Voxel Cut", cut), ("Voxel Cut", case.voxel_cut())):
+    gap, events, seconds = watch(proxy)
+    ft.check(gap <= MAX_GAP, "%s on BraTS: %d progress events over %.2f s, longest gap %.3f s (<= %.1f s)" % (name, events, seconds, gap, MAX_GAP))
+
+# Abort in the middle of the voxel cut's max-flow (its longest step), from a progress observer.
+vc = case.voxel_cut()
+algorithm = vc.GetClientSideObject()
+asked = []
+
+
+def abort_in_flow(o, e):
+    if o.GetProgress() > 0.7 and not asked:
+        asked.append(time.perf_counter())
+        o.SetAbortExecute(1)
+
+
+tag = algorithm.AddObserver("ProgressEvent", abort_in_flow)
+vc.UpdatePipeline()
+returned = time.perf_counter()
+algorithm.RemoveObserver(tag)
+ft.check(bool(asked), "the abort was asked during the flow")
+if asked:
+    ft.check(returned - asked[0] < 1.0, "Voxel Cut returns %.2f s after the abort (< 1 s)" % (returned - asked[0]))
+ft.check(ft.fetch(vc).GetNumberOfPoints() == 0, "the aborted output is empty")
+algorithm.SetAbortExecute(0)
+vc.UpdatePipeline()
+labels = ft.fm.labels(vc, 0)
+ft.check(labels.size == 240 * 240 * 155 and 0 < labels.sum() < labels.size, "the next update runs the cut again (%d object voxels)" % labels.sum())
+
+# The same for the super-voxel cut, aborted in its setup.
+sv = case.super_voxel_cut(mesh)
+algorithm = sv.GetClientSideObject()
+tag = algorithm.AddObserver("ProgressEvent", lambda o, e: o.SetAbortExecute(1) if o.GetProgress() > 0.3 else None)
+sv.UpdatePipeline()
+algorithm.RemoveObserver(tag)
+ft.check(ft.fetch(sv).GetNumberOfCells() == 0, "an aborted Super-Voxel Cut has an empty output")
+algorithm.SetAbortExecute(0)
+sv.UpdatePipeline()
+ft.check(ft.fetch(sv).GetNumberOfCells() > 0, "and runs again on the next update")
