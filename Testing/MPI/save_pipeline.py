@@ -1,0 +1,18 @@
+"""Run under mpirun -np N pvbatch: the pipeline on the bundled cases, saved in parallel formats."""
+import os
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
+import featuremesh as fm  # noqa: E402
+
+fm.load_plugin()
+import paraview.simple as ps  # noqa: E402
+
+out = sys.argv[1]
+for name in ("nuclei-dsb2018", "liver-ct-totalseg"):
+    c = fm.Case(fm.case_dir(name))
+    nodes, mesh, cut = c.pipeline()
+    cut.UpdatePipeline()
+    ps.SaveData(os.path.join(out, name + "_labelled.pvtu"), proxy=ps.OutputPort(cut, 0))
+    ps.SaveData(os.path.join(out, name + "_labels.pvti"), proxy=ps.OutputPort(cut, 2))
+    ps.SaveData(os.path.join(out, name + "_voxelcut.pvti"), proxy=c.voxel_cut())
