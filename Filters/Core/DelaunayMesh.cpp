@@ -77,6 +77,42 @@ DelaunayResult TetrahedralizeCGAL(const std::vector<std::array<double, 3>>& poin
   return r;
 }
 
+// The indices of the eight corners of the points' bounding box (bit 0: x max, bit 1: y max, bit 2:
+// z max); false when one of them is not a point.
+bool BoxCorners(const std::vector<std::array<double, 3>>& points, std::array<int, 8>& corner, std::string& error)
+{
+  std::array<double, 3> lo = points[0], hi = points[0];
+  for (const auto& p : points)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      lo[a] = std::min(lo[a], p[a]);
+      hi[a] = std::max(hi[a], p[a]);
+    }
+  }
+  corner.fill(-1);
+  for (size_t i = 0; i < points.size(); ++i)
+  {
+    int c = 0;
+    bool isCorner = true;
+    for (int a = 0; a < 3 && isCorner; ++a)
+    {
+      isCorner = points[i][a] == lo[a] || points[i][a] == hi[a];
+      c |= (points[i][a] == hi[a] ? 1 : 0) << a;
+    }
+    if (isCorner && corner[c] < 0)
+    {
+      corner[c] = static_cast<int>(i);
+    }
+  }
+  if (*std::min_element(corner.begin(), corner.end()) < 0)
+  {
+    error = "quality refinement needs the eight corners of the nodes' bounding box among the nodes.";
+    return false;
+  }
+  return true;
+}
+
 DelaunayResult TetrahedralizeTetGen(const std::vector<std::array<double, 3>>& points, const DelaunayOptions& o)
 {
   DelaunayResult r;
@@ -92,8 +128,84 @@ DelaunayResult TetrahedralizeTetGen(const std::vector<std::array<double, 3>>& po
   std::string switches = "Qz";
   if (o.QualityRefinement)
   {
+    // Refinement needs a domain: the box, as six quadrilateral facets on its corner nodes (p);
+    // the other nodes are inserted into it. Without it TetGen's q discards every tetrahedron.
+    std::array<int, 8> corner;
+    std::string error;
+    if (!BoxCorners(points, corner, error))
+    {
+      r.Error = error;
+      return r;
+    }
+    // Each box face is a facet: its boundary loop through every node on the face's four edges, in
+    // order (a node inside a boundary segment makes TetGen assert), and every other node on the
+    // face as a one-vertex polygon.
+    const std::array<double, 3> lo = points[corner[0]], hi = points[corner[7]];
+    in.numberoffacets = 6;
+    in.facetlist = new tetgenio::facet[6];
+    in.facetmarkerlist = new int[6];
+    for (int f = 0; f < 6; ++f)
+    {
+      const int axis = f / 2, u = (axis + 1) % 3, v = (axis + 2) % 3;
+      const double plane = f % 2 ? hi[axis] : lo[axis];
+      // Boundary nodes keyed by their position along the loop lo-u, hi-u, hi-v, ... (perimeter).
+      std::vector<std::pair<double, int>> loop;
+      std::vector<int> inside;
+      const double du = hi[u] - lo[u], dv = hi[v] - lo[v];
+      for (size_t i = 0; i < points.size(); ++i)
+      {
+        const auto& p = points[i];
+        if (p[axis] != plane)
+        {
+          continue;
+        }
+        const bool uLo = p[u] == lo[u], uHi = p[u] == hi[u], vLo = p[v] == lo[v], vHi = p[v] == hi[v];
+        double key = -1;
+        if (vLo)
+        {
+          key = p[u] - lo[u];
+        }
+        else if (uHi)
+        {
+          key = du + (p[v] - lo[v]);
+        }
+        else if (vHi)
+        {
+          key = du + dv + (hi[u] - p[u]);
+        }
+        else if (uLo)
+        {
+          key = 2 * du + dv + (hi[v] - p[v]);
+        }
+        if (key >= 0)
+        {
+          loop.emplace_back(key, static_cast<int>(i));
+        }
+        else
+        {
+          inside.push_back(static_cast<int>(i));
+        }
+      }
+      std::sort(loop.begin(), loop.end());
+      tetgenio::facet& facet = in.facetlist[f];
+      tetgenio::init(&facet);
+      facet.numberofpolygons = 1 + static_cast<int>(inside.size());
+      facet.polygonlist = new tetgenio::polygon[facet.numberofpolygons];
+      for (int k = 0; k < facet.numberofpolygons; ++k)
+      {
+        tetgenio::polygon& polygon = facet.polygonlist[k];
+        tetgenio::init(&polygon);
+        polygon.numberofvertices = k == 0 ? static_cast<int>(loop.size()) : 1;
+        polygon.vertexlist = new int[polygon.numberofvertices];
+        for (int w = 0; w < polygon.numberofvertices; ++w)
+        {
+          polygon.vertexlist[w] = k == 0 ? loop[w].second : inside[k - 1];
+        }
+      }
+      in.facetmarkerlist[f] = f + 1;
+    }
     char buffer[64];
-    std::snprintf(buffer, sizeof(buffer), "q%g/%g", o.RadiusEdgeRatio, o.MinDihedralAngle);
+    std::snprintf(buffer, sizeof(buffer), "pq%g/%g", o.RadiusEdgeRatio, o.MinDihedralAngle);
     switches += buffer;
   }
   std::vector<char> sw(switches.begin(), switches.end());

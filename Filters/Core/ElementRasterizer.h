@@ -5,12 +5,16 @@
 // p + e(c - p) + e^2 t, e -> 0, with c the box centre and t a lexicographic direction. The first
 // term pulls centres on the box surface inside, the second breaks the remaining ties, so every
 // centre belongs to exactly one element. Node coordinates on voxel centres are integers in index
-// space, so every test is exact in double arithmetic (added, off-lattice nodes are rounded).
+// space, so every test is exact in double arithmetic; for nodes off the lattice (refinement,
+// smoothing) the two sides of a face still agree bit for bit, because each face's plane is formed
+// from its vertex ids in a fixed order.
 #pragma once
 
+#include "ExactPredicates.h"
 #include "Parallel.h"
 #include "SimplexMesh.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -33,7 +37,16 @@ public:
   void ForEachVoxel(std::int64_t e, Visitor&& visit) const;
 
 private:
-  bool Owns(const double* plane, int faces, double x, double y, double z) const;
+  // A face: its plane (n, d) with the element on the positive side, and, for elements with a node
+  // off the voxel lattice, its vertices in ascending id order and the sign that orients them.
+  struct Face
+  {
+    double Plane[4];
+    const std::array<double, 3>* Vertex[3];
+    double Sign;
+  };
+  bool Owns(const Face* face, int faces, bool offLattice, double x, double y, double z) const;
+  bool ExactTie(const Face& face, int faces) const;
 
   const SimplexMesh* M;
   double TwiceCentre[3];
@@ -68,12 +81,21 @@ double InterpolateAt(const double* values, const ImageGeometry& grid, const doub
 
 //------------------------------------------------------------------------------------------------
 // Inline: called once per candidate voxel centre.
-inline bool ElementRasterizer::Owns(const double* plane, int faces, double x, double y, double z) const
+inline bool ElementRasterizer::Owns(const Face* face, int faces, bool offLattice, double x, double y, double z) const
 {
   for (int f = 0; f < faces; ++f)
   {
-    const double* n = plane + 4 * f;
-    const double lambda = n[0] * x + n[1] * y + n[2] * z + n[3];
+    const double* n = face[f].Plane;
+    double lambda = n[0] * x + n[1] * y + n[2] * z + n[3];
+    if (offLattice && std::fabs(lambda) < 1e-9 * (std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2])) * (1.0 + std::fabs(x) + std::fabs(y) + std::fabs(z)))
+    {
+      // Off the lattice the plane is rounded: a centre on or a hair from the face is decided by
+      // the exact sign (on the lattice every test above is exact integer arithmetic).
+      const std::array<double, 3> c = { { x, y, z } };
+      const Face& F = face[f];
+      lambda = F.Sign * (faces == 3 ? Orientation2(*F.Vertex[0], *F.Vertex[1], c)
+                                    : Orientation3(*F.Vertex[0], *F.Vertex[1], *F.Vertex[2], c));
+    }
     if (lambda > 0)
     {
       continue;
@@ -83,6 +105,14 @@ inline bool ElementRasterizer::Owns(const double* plane, int faces, double x, do
       return false;
     }
     // On the face plane: decide by the pull towards the box centre, then lexicographically.
+    if (offLattice)
+    {
+      if (!this->ExactTie(face[f], faces))
+      {
+        return false;
+      }
+      continue;
+    }
     const double toCentre = n[0] * (this->TwiceCentre[0] - 2 * x) + n[1] * (this->TwiceCentre[1] - 2 * y) +
       (faces == 3 ? 0.0 : n[2] * (this->TwiceCentre[2] - 2 * z));
     if (toCentre < 0)
@@ -101,6 +131,35 @@ inline bool ElementRasterizer::Owns(const double* plane, int faces, double x, do
   return true;
 }
 
+// The tie rule with exact signs, for a centre exactly on a face of an element off the lattice: on
+// the plane, n.(c - p) has the sign of the box centre c's orientation; then the signs of n's
+// components, which are orientations of the face projected on the yz, zx and xy planes.
+inline bool ElementRasterizer::ExactTie(const Face& F, int faces) const
+{
+  const std::array<double, 3> centre = { { 0.5 * this->TwiceCentre[0], 0.5 * this->TwiceCentre[1],
+    faces == 3 ? 0.0 : 0.5 * this->TwiceCentre[2] } };
+  const auto& a = *F.Vertex[0];
+  const auto& b = *F.Vertex[1];
+  int side = faces == 3 ? Orientation2(a, b, centre) : Orientation3(a, b, *F.Vertex[2], centre);
+  if (side == 0)
+  {
+    if (faces == 3)
+    {
+      // n = (-(b_y - a_y), b_x - a_x).
+      side = a[1] > b[1] ? 1 : (a[1] < b[1] ? -1 : (b[0] > a[0] ? 1 : (b[0] < a[0] ? -1 : 0)));
+    }
+    else
+    {
+      const auto& c = *F.Vertex[2];
+      auto project = [](const std::array<double, 3>& q, int s, int t) { return std::array<double, 3>{ { q[s], q[t], 0.0 } }; };
+      side = Orientation2(project(a, 1, 2), project(b, 1, 2), project(c, 1, 2));
+      side = side ? side : Orientation2(project(a, 2, 0), project(b, 2, 0), project(c, 2, 0));
+      side = side ? side : Orientation2(project(a, 0, 1), project(b, 0, 1), project(c, 0, 1));
+    }
+  }
+  return F.Sign * side > 0;
+}
+
 template <typename Visitor>
 void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
 {
@@ -109,7 +168,6 @@ void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
   const auto& G = this->M->Geometry();
   const int faces = this->M->VerticesPerCell();
   // Plane per face: lambda(p) = n.p + d, positive on the side of the opposite vertex.
-  double plane[4][4];
   double lo[3] = { 1e300, 1e300, 1e300 }, hi[3] = { -1e300, -1e300, -1e300 };
   for (int v = 0; v < faces; ++v)
   {
@@ -119,43 +177,62 @@ void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
       hi[a] = std::max(hi[a], P[cell[v]][a]);
     }
   }
+  Face face[4];
+  bool offLattice = false;
+  for (int v = 0; v < faces; ++v)
+  {
+    const auto& q = P[cell[v]];
+    offLattice = offLattice || q[0] != std::floor(q[0]) || q[1] != std::floor(q[1]) || q[2] != std::floor(q[2]);
+  }
+  // Each face's plane from its vertex ids in ascending order, so that the two elements sharing a
+  // face compute the same numbers and exactly opposite signs: every centre has one owner even for
+  // nodes off the voxel lattice (on it, all of this is exact integer arithmetic anyway).
   for (int f = 0; f < faces; ++f)
   {
-    double n[3];
+    std::int64_t ids[3];
+    int k = 0;
+    for (int v = 0; v < faces; ++v)
+    {
+      if (v != f)
+      {
+        ids[k++] = cell[v];
+      }
+    }
+    std::sort(ids, ids + faces - 1);
+    const auto& p = P[ids[0]];
+    const auto& q = P[ids[1]];
+    double n[3], d;
     if (faces == 3)
     {
-      const auto& p = P[cell[(f + 1) % 3]];
-      const auto& q = P[cell[(f + 2) % 3]];
-      // Inward normal of a counter-clockwise edge p->q.
       n[0] = -(q[1] - p[1]);
       n[1] = q[0] - p[0];
       n[2] = 0.0;
-      plane[f][3] = -(n[0] * p[0] + n[1] * p[1]);
+      d = -(n[0] * p[0] + n[1] * p[1]);
     }
     else
     {
-      const auto& p = P[cell[(f + 1) % 4]];
-      const auto& q = P[cell[(f + 2) % 4]];
-      const auto& r = P[cell[(f + 3) % 4]];
+      const auto& r = P[ids[2]];
       const double u[3] = { q[0] - p[0], q[1] - p[1], q[2] - p[2] };
       const double w[3] = { r[0] - p[0], r[1] - p[1], r[2] - p[2] };
       n[0] = u[1] * w[2] - u[2] * w[1];
       n[1] = u[2] * w[0] - u[0] * w[2];
       n[2] = u[0] * w[1] - u[1] * w[0];
-      const auto& o = P[cell[f]];
-      double d = -(n[0] * p[0] + n[1] * p[1] + n[2] * p[2]);
-      if (n[0] * o[0] + n[1] * o[1] + n[2] * o[2] + d < 0)
-      {
-        n[0] = -n[0];
-        n[1] = -n[1];
-        n[2] = -n[2];
-        d = -d;
-      }
-      plane[f][3] = d;
+      d = -(n[0] * p[0] + n[1] * p[1] + n[2] * p[2]);
     }
-    plane[f][0] = n[0];
-    plane[f][1] = n[1];
-    plane[f][2] = n[2];
+    // Positive on the side of the opposite vertex (exactly, off the lattice: slivers are flat).
+    const auto& o = P[cell[f]];
+    const double sign = offLattice
+      ? (faces == 3 ? Orientation2(p, q, o) : Orientation3(p, q, P[ids[2]], o)) < 0 ? -1.0 : 1.0
+      : (n[0] * o[0] + n[1] * o[1] + n[2] * o[2] + d < 0 ? -1.0 : 1.0);
+    face[f].Plane[0] = sign * n[0];
+    face[f].Plane[1] = sign * n[1];
+    face[f].Plane[2] = sign * n[2];
+    face[f].Plane[3] = sign * d;
+    face[f].Sign = sign;
+    for (int v = 0; v < faces - 1; ++v)
+    {
+      face[f].Vertex[v] = &P[ids[v]];
+    }
   }
   const int i0 = std::max(0, static_cast<int>(std::ceil(lo[0]))), i1 = std::min(G.Dims[0] - 1, static_cast<int>(std::floor(hi[0])));
   const int j0 = std::max(0, static_cast<int>(std::ceil(lo[1]))), j1 = std::min(G.Dims[1] - 1, static_cast<int>(std::floor(hi[1])));
@@ -166,21 +243,27 @@ void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
     for (int j = j0; j <= j1; ++j)
     {
       // Candidate x-interval from the face planes, widened by one voxel; the exact test decides.
+      // Off the lattice b carries rounding, which a plane nearly parallel to x (tiny a) magnifies:
+      // the bounds move out by that error, so that the interval stays a superset.
       double xlo = i0, xhi = i1;
       bool empty = false;
       for (int f = 0; f < faces && !empty; ++f)
       {
-        const double a = plane[f][0];
-        const double b = plane[f][1] * j + plane[f][2] * k + plane[f][3];
+        const double* n = face[f].Plane;
+        const double a = n[0];
+        const double b = n[1] * j + n[2] * k + n[3];
+        const double slack = offLattice
+          ? 1e-9 * (std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2])) * (1.0 + G.Dims[0] + j + k)
+          : 0.0;
         if (a > 0)
         {
-          xlo = std::max(xlo, -b / a);
+          xlo = std::max(xlo, (-b - slack) / a);
         }
         else if (a < 0)
         {
-          xhi = std::min(xhi, -b / a);
+          xhi = std::min(xhi, (-b - slack) / a);
         }
-        else if (b < 0)
+        else if (b < -slack)
         {
           empty = true;
         }
@@ -194,7 +277,7 @@ void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
       std::int64_t idx = G.Index(s, j, k);
       for (int i = s; i <= t; ++i, ++idx)
       {
-        if (this->Owns(&plane[0][0], faces, i, j, k))
+        if (this->Owns(face, faces, offLattice, i, j, k))
         {
           visit(idx);
         }

@@ -35,12 +35,12 @@ inline ProgressFunction NoProgress()
   return [](double) { return true; };
 }
 
-// `body` over [0, n) in up to 16 sequential batches, each run by `parallel`, with progress
+// `body` over [0, n) in up to 8 sequential batches, each run by `parallel`, with progress
 // reported between batches on this thread; false when progress asked to abort.
 inline bool BatchedFor(std::int64_t n, std::int64_t grain, const ParallelFor& parallel, const ProgressFunction& progress,
   const RangeFunction& body)
 {
-  const std::int64_t batches = 16, size = (n + batches - 1) / batches;
+  const std::int64_t batches = 8, size = (n + batches - 1) / batches;
   for (std::int64_t b = 0; b < n; b += size)
   {
     const std::int64_t e = std::min(n, b + size);

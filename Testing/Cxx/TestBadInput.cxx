@@ -614,6 +614,19 @@ TEST(DelaunayImageMesh, MirroredDirection)
   image->SetDirectionMatrix(direction);
   DelaunayMesh(NodesOf(image), image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectTiling(run, out, image); });
 }
+TEST(DelaunayImageMesh, QualityRefinement)
+{
+  auto image = Ball();
+  image->SetSpacing(1.0, 1.5, 2.0);
+  DelaunayMesh(NodesOf(image), image,
+    [&](auto& run, vtkUnstructuredGrid* out) {
+      ExpectTiling(run, out, image);
+      vtkDataArray* angle = out->GetCellData()->GetArray("MinDihedralAngle");
+      ASSERT_NE(angle, nullptr);
+      EXPECT_GE(angle->GetRange()[0], 9.99);
+    },
+    [](vtkDelaunayImageMesh* m) { m->SetQualityRefinement(true); });
+}
 TEST(DelaunayImageMesh, RefinementParametersOutOfRange)
 {
   auto image = Ball();

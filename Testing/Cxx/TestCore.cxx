@@ -1005,3 +1005,48 @@ TEST(Guards, HeartbeatReportsAbortsAndRethrows)
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 0.5);
   EXPECT_THROW(RunWithHeartbeat<int>([]() -> int { throw std::bad_alloc(); }, NoProgress(), value), std::bad_alloc);
 }
+
+// TetGen quality refinement needs the box as its domain: it adds nodes, raises the smallest
+// dihedral angle, and the mesh still tiles the box exactly once per voxel.
+TEST(Delaunay, QualityRefinementRaisesTheMinimumDihedralAngle)
+{
+  ImageGeometry g;
+  g.Dims = { { 21, 17, 13 } };
+  g.Spacing = { { 1.0, 1.5, 2.0 } };
+  std::mt19937 rng(3);
+  std::vector<std::array<double, 3>> index;
+  std::vector<int> used(g.Size(), 0);
+  auto add = [&](int i, int j, int k) {
+    if (!used[g.Index(i, j, k)]++)
+      index.push_back({ { double(i), double(j), double(k) } });
+  };
+  for (int c = 0; c < 8; ++c)
+    add((c & 1) ? 20 : 0, (c & 2) ? 16 : 0, (c & 4) ? 12 : 0);
+  for (int t = 0; t < 30; ++t) // nodes on the faces, as Feature Nodes places boundary nodes
+    add(rng() % 21, rng() % 17, (t % 2) ? 12 : 0), add(0, rng() % 17, rng() % 13), add(rng() % 21, 16, rng() % 13);
+  for (int t = 0; t < 150; ++t)
+    add(1 + rng() % 19, 1 + rng() % 15, 1 + rng() % 11);
+  std::vector<std::array<double, 3>> frame;
+  for (const auto& p : index)
+    frame.push_back(g.IndexToFrame(p));
+  DelaunayOptions plain, refined;
+  refined.QualityRefinement = true;
+  const DelaunayResult a = Tetrahedralize(frame, plain), b = Tetrahedralize(frame, refined);
+  ASSERT_TRUE(a.Error.empty()) << a.Error;
+  ASSERT_TRUE(b.Error.empty()) << b.Error;
+  EXPECT_GT(b.Points.size(), a.Points.size());
+  auto smallest = [&](const DelaunayResult& d) {
+    std::vector<std::array<double, 3>> idx;
+    for (const auto& p : d.Points)
+      idx.push_back(g.FrameToIndex(p));
+    const SimplexMesh mesh(g, idx, d.Cells, 4);
+    std::vector<double> angle, ratio;
+    ElementQuality(mesh, angle, ratio, SerialFor());
+    const auto s = ComputeElementStatistics(ElementRasterizer(mesh), std::vector<double>(g.Size(), 1.0).data(), SerialFor());
+    EXPECT_EQ(std::accumulate(s.PixelCount.begin(), s.PixelCount.end(), std::int64_t(0)), g.Size());
+    return *std::min_element(angle.begin(), angle.end());
+  };
+  const double before = smallest(a), after = smallest(b);
+  EXPECT_GT(after, before);
+  EXPECT_GT(after, 5.0);
+}

@@ -112,3 +112,26 @@ m3 = ft.DelaunayImageMesh(Nodes=flat, Image=image3)
 m3.UpdatePipeline()
 ft.check(ft.fetch(m3).GetNumberOfCells() == 0, "coplanar nodes in 3D: error")
 print("all mesh checks passed")
+
+# Quality refinement (TetGen with the box as its domain) on the 3D cases: the requested minimum
+# dihedral angle is reached, nodes are added, and every voxel still has exactly one element.
+for case in ("liver-ct-totalseg", "brain-tumour-brats-0005"):
+    if ft.fm.case_dir(case) is None:
+        print("SKIP: %s not found" % case)
+        continue
+    c = ft.fm.Case(ft.fm.case_dir(case))
+    nodes = c.feature_nodes()
+    plain, refined = c.mesh(nodes), c.mesh(nodes, QualityRefinement=1, MinDihedralAngle=10, RadiusEdgeRatio=2)
+    p, r = ft.fetch(plain), ft.fetch(refined)
+    angle = ft.array(r, "MinDihedralAngle", cells=True).min()
+    added = r.GetNumberOfPoints() - p.GetNumberOfPoints()
+    ft.check(angle >= 9.99, "%s: quality refinement reaches a minimum dihedral angle of %.2f deg (plain mesh %.2f deg)" % (
+        case, angle, ft.array(p, "MinDihedralAngle", cells=True).min()))
+    ft.check(added > 0 and r.GetFieldData().GetArray("AddedNodes").GetValue(0) == added, "%s: %d nodes added (%d -> %d)" % (
+        case, added, p.GetNumberOfPoints(), r.GetNumberOfPoints()))
+    ft.check(ft.array(r, "PixelCount", cells=True).sum() == ft.fetch(c.image).GetNumberOfPoints(),
+             "%s: every voxel has one element after refinement" % case)
+    types = ft.array(r, "NodeType")
+    fixed = ft.array(r, "Fixed")
+    ft.check((types[p.GetNumberOfPoints():] == 4).all() and (fixed[p.GetNumberOfPoints():] == 0).all(),
+             "%s: added nodes are NodeType 4, not fixed" % case)
