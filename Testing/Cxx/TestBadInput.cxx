@@ -112,7 +112,8 @@ vtkSmartPointer<vtkImageData> Image(std::array<int, 3> dims, const Fill& fill, i
 Fill Noisy(double cx, double cy, double cz, double r)
 {
   return [=](int i, int j, int k) {
-    const unsigned h = static_cast<unsigned>(i * 73856093) ^ static_cast<unsigned>(j * 19349663) ^ static_cast<unsigned>(k * 83492791);
+    const unsigned h = (static_cast<unsigned>(i) * 73856093u) ^ (static_cast<unsigned>(j) * 19349663u) ^
+      (static_cast<unsigned>(k) * 83492791u);
     const double noise = static_cast<double>(h % 1000) / 100.0 - 5.0;
     return (std::hypot(i - cx, j - cy, k - cz) <= r ? 100.0 : 20.0) + noise;
   };
