@@ -280,19 +280,9 @@ bool ToSimplexMesh(vtkUnstructuredGrid* grid, const ImageGeometry& geometry, Sim
   {
     return false;
   }
-  // Positive orientation in index space, whatever the writer's convention or the frame's mirror.
-  std::vector<std::int64_t> oriented = result.Cells();
-  bool flipped = false;
-  for (vtkIdType c = 0; c < nCells; ++c)
-  {
-    std::int64_t* cell = oriented.data() + c * vpc;
-    if (ElementMeasure(result.Points(), cell, vpc) < 0)
-    {
-      std::swap(cell[vpc - 2], cell[vpc - 1]);
-      flipped = true;
-    }
-  }
-  mesh = flipped ? SimplexMesh(geometry, result.Points(), std::move(oriented), vpc) : std::move(result);
+  // Whatever the writer's convention or the frame's mirror.
+  result.OrientPositively();
+  mesh = std::move(result);
   return true;
 }
 

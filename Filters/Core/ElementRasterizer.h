@@ -169,21 +169,18 @@ void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
   const int faces = this->M->VerticesPerCell();
   // Plane per face: lambda(p) = n.p + d, positive on the side of the opposite vertex.
   double lo[3] = { 1e300, 1e300, 1e300 }, hi[3] = { -1e300, -1e300, -1e300 };
-  for (int v = 0; v < faces; ++v)
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      lo[a] = std::min(lo[a], P[cell[v]][a]);
-      hi[a] = std::max(hi[a], P[cell[v]][a]);
-    }
-  }
-  Face face[4];
   bool offLattice = false;
   for (int v = 0; v < faces; ++v)
   {
     const auto& q = P[cell[v]];
-    offLattice = offLattice || q[0] != std::floor(q[0]) || q[1] != std::floor(q[1]) || q[2] != std::floor(q[2]);
+    for (int a = 0; a < 3; ++a)
+    {
+      lo[a] = std::min(lo[a], q[a]);
+      hi[a] = std::max(hi[a], q[a]);
+      offLattice = offLattice || q[a] != std::floor(q[a]);
+    }
   }
+  Face face[4];
   // Each face's plane from its vertex ids in ascending order, so that the two elements sharing a
   // face compute the same numbers and exactly opposite signs: every centre has one owner even for
   // nodes off the voxel lattice (on it, all of this is exact integer arithmetic anyway).

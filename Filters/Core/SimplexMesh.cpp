@@ -210,6 +210,24 @@ std::string SimplexMesh::Validate() const
   return std::string();
 }
 
+void SimplexMesh::OrientPositively()
+{
+  bool flipped = false;
+  for (std::int64_t e = 0; e < this->NumberOfElements(); ++e)
+  {
+    std::int64_t* cell = this->CellIds.data() + e * this->Vpc;
+    if (ElementMeasure(this->IndexPoints, cell, this->Vpc) < 0)
+    {
+      std::swap(cell[this->Vpc - 2], cell[this->Vpc - 1]);
+      flipped = true;
+    }
+  }
+  if (flipped)
+  {
+    this->Cached = std::make_shared<Cache>();
+  }
+}
+
 void SimplexMesh::SetPoints(std::vector<std::array<double, 3>> indexPoints)
 {
   this->IndexPoints = std::move(indexPoints);

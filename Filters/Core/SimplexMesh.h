@@ -58,6 +58,10 @@ public:
   // Empty when every cell id names a point and the element type matches the image's dimension.
   std::string Validate() const;
 
+  // Orients every element positively in index space (swaps two ids of the others); drops the
+  // cached adjacency when it changes anything.
+  void OrientPositively();
+
   // Replaces the points (same count; stage 3 moves them), dropping the face measures.
   void SetPoints(std::vector<std::array<double, 3>> indexPoints);
 
