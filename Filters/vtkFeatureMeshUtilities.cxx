@@ -522,4 +522,19 @@ void AddFieldValue(vtkDataObject* object, const char* name, double value)
   object->GetFieldData()->AddArray(a);
 }
 
+void AddObjectComponents(vtkDataObject* object, const std::vector<double>& componentVoxels, double voxelVolume,
+  std::int64_t connectivityChanged)
+{
+  AddFieldValue(object, names::ObjectComponents, static_cast<double>(componentVoxels.size()));
+  vtkNew<vtkDoubleArray> volumes;
+  volumes->SetName(names::ObjectComponentVolumes);
+  volumes->SetNumberOfValues(static_cast<vtkIdType>(componentVoxels.size()));
+  for (std::size_t c = 0; c < componentVoxels.size(); ++c)
+  {
+    volumes->SetValue(static_cast<vtkIdType>(c), componentVoxels[c] * voxelVolume);
+  }
+  object->GetFieldData()->AddArray(volumes);
+  AddFieldValue(object, names::ConnectivityChanged, static_cast<double>(connectivityChanged));
+}
+
 } // namespace featuremesh

@@ -146,6 +146,11 @@ bool ChosenValues(vtkImageData* image, vtkInformation* arrayInfo, std::vector<do
 
 // Adds a one-value double array `name` to the object's field data (summaries, timings).
 void AddFieldValue(vtkDataObject* object, const char* name, double value);
+
+// Adds the object components of a cut to the field data: ObjectComponents (their number),
+// ObjectComponentVolumes (world units, largest first) and ConnectivityChanged.
+void AddObjectComponents(vtkDataObject* object, const std::vector<double>& componentVoxels, double voxelVolume,
+  std::int64_t connectivityChanged);
 } // namespace featuremesh
 
 #endif

@@ -10,6 +10,7 @@
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
+#include "vtkIdTypeArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -35,8 +36,12 @@ vtkSuperVoxelCut::vtkSuperVoxelCut()
   this->Bins = defaults.Bins;
   this->Sigma = defaults.Sigma;
   this->Lambda = defaults.Lambda;
+  this->Connectivity = static_cast<int>(defaults.Connectivity);
+  this->Bandwidth = defaults.Bandwidth;
   this->ScaleByContact = defaults.ScaleByContact;
   this->VoxelRegionTerm = defaults.VoxelRegionTerm;
+  this->SampleSeedElements = defaults.SampleSeedElements;
+  this->SeedRadius = defaults.SeedRadius;
   this->SetNumberOfInputPorts(4);
   this->SetNumberOfOutputPorts(3);
   this->SetInputArrayToProcess(0, 3, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
@@ -108,8 +113,12 @@ int vtkSuperVoxelCut::RequestData(
     par.Bins = this->Bins;
     par.Sigma = this->Sigma;
     par.Lambda = this->Lambda;
+    par.Connectivity = static_cast<featuremesh::Connectivity>(this->Connectivity);
+    par.Bandwidth = this->Bandwidth;
     par.ScaleByContact = this->ScaleByContact;
     par.VoxelRegionTerm = this->VoxelRegionTerm;
+    par.SampleSeedElements = this->SampleSeedElements;
+    par.SeedRadius = this->SeedRadius;
     error = ValidateParameters(par);
     if (!error.empty())
     {
@@ -241,6 +250,14 @@ int vtkSuperVoxelCut::RequestData(
     voxels->SetNumberOfTuples(geometry.Size());
     std::copy(voxelLabels.begin(), voxelLabels.end(), voxels->GetPointer(0));
     labelImage->GetPointData()->SetScalars(voxels);
+    if (this->SuperVoxelIds)
+    {
+      vtkNew<vtkIdTypeArray> ids;
+      ids->SetName(names::ElementId);
+      ids->SetNumberOfTuples(geometry.Size());
+      std::copy(result.VoxelOwner.begin(), result.VoxelOwner.end(), ids->GetPointer(0));
+      labelImage->GetPointData()->AddArray(ids);
+    }
 
     const auto objectElements = std::count(cut.Label.begin(), cut.Label.end(), LabelObject);
     for (vtkDataObject* d : { static_cast<vtkDataObject*>(output), static_cast<vtkDataObject*>(labelImage) })
@@ -249,6 +266,7 @@ int vtkSuperVoxelCut::RequestData(
       AddFieldValue(d, names::Bins, cut.Bins);
       AddFieldValue(d, names::Flow, cut.Flow);
       AddFieldValue(d, names::ObjectElements, static_cast<double>(objectElements));
+      AddObjectComponents(d, cut.ObjectComponentVoxels, geometry.VoxelVolume(), cut.ConnectivityChanged);
       AddFieldValue(d, names::SetupSeconds, result.SetupSeconds);
       AddFieldValue(d, names::GraphSeconds, cut.GraphSeconds);
       AddFieldValue(d, names::FlowSeconds, cut.FlowSeconds);
@@ -265,6 +283,9 @@ void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Bins: " << this->Bins << "\n"
      << indent << "Sigma: " << this->Sigma << "\n"
      << indent << "Lambda: " << this->Lambda << "\n"
+     << indent << "Connectivity: " << this->Connectivity << "\n"
+     << indent << "Bandwidth: " << this->Bandwidth << "\n"
+     << indent << "SuperVoxelIds: " << this->SuperVoxelIds << "\n"
      << indent << "ScaleByContact: " << this->ScaleByContact << "\n"
      << indent << "VoxelRegionTerm: " << this->VoxelRegionTerm << "\n";
 }

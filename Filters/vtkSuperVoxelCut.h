@@ -35,6 +35,12 @@ public:
   /// Region-term weight lambda.
   vtkSetMacro(Lambda, double);
   vtkGetMacro(Lambda, double);
+  /// What the seeds reach (featuremesh::Connectivity): 0 off, 1 fill holes, 2 one seeded object.
+  vtkSetClampMacro(Connectivity, int, 0, 2);
+  vtkGetMacro(Connectivity, int);
+  /// Kernel bandwidth of the seed histograms as a multiple of Silverman's rule (default 1).
+  vtkSetMacro(Bandwidth, double);
+  vtkGetMacro(Bandwidth, double);
   /// Scale boundary weights by the shared edge length / face area (default on).
   vtkSetMacro(ScaleByContact, bool);
   vtkGetMacro(ScaleByContact, bool);
@@ -44,6 +50,19 @@ public:
   vtkSetMacro(VoxelRegionTerm, bool);
   vtkGetMacro(VoxelRegionTerm, bool);
   vtkBooleanMacro(VoxelRegionTerm, bool);
+  /// With the Image connected: the histograms sample the voxels of the seed elements (on), or the
+  /// voxels within SeedRadius of each seed, as the Voxel Cut does (off).
+  vtkSetMacro(SampleSeedElements, bool);
+  vtkGetMacro(SampleSeedElements, bool);
+  vtkBooleanMacro(SampleSeedElements, bool);
+  /// Adds ElementId (the element owning each voxel, -1 none) to the label image: the mesh as a
+  /// super-voxel label image (default off).
+  vtkSetMacro(SuperVoxelIds, bool);
+  vtkGetMacro(SuperVoxelIds, bool);
+  vtkBooleanMacro(SuperVoxelIds, bool);
+  /// Radius (voxels) of each seed's neighbourhood when SampleSeedElements is off.
+  vtkSetMacro(SeedRadius, double);
+  vtkGetMacro(SeedRadius, double);
 
 protected:
   vtkSuperVoxelCut();
@@ -58,8 +77,13 @@ protected:
   int Bins;
   double Sigma;
   double Lambda;
+  int Connectivity;
+  double Bandwidth;
   bool ScaleByContact;
   bool VoxelRegionTerm;
+  bool SampleSeedElements;
+  bool SuperVoxelIds = false;
+  double SeedRadius;
 
 private:
   // The pipeline state of the last failed run (0: none), so that it is not repeated.

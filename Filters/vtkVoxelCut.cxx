@@ -28,6 +28,8 @@ vtkVoxelCut::vtkVoxelCut()
   this->Bins = defaults.Bins;
   this->Sigma = defaults.Sigma;
   this->Lambda = defaults.Lambda;
+  this->Connectivity = static_cast<int>(defaults.Connectivity);
+  this->Bandwidth = defaults.Bandwidth;
   this->SeedRadius = defaults.SeedRadius;
   this->SetNumberOfInputPorts(3);
   this->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
@@ -84,6 +86,8 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     par.Bins = this->Bins;
     par.Sigma = this->Sigma;
     par.Lambda = this->Lambda;
+    par.Connectivity = static_cast<featuremesh::Connectivity>(this->Connectivity);
+    par.Bandwidth = this->Bandwidth;
     par.SeedRadius = this->SeedRadius;
     error = ValidateParameters(par);
     if (!error.empty())
@@ -128,6 +132,7 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     AddFieldValue(output, names::Flow, cut.Flow);
     AddFieldValue(output, names::GraphSeconds, cut.GraphSeconds);
     AddFieldValue(output, names::FlowSeconds, cut.FlowSeconds);
+    AddObjectComponents(output, cut.ObjectComponentVoxels, geometry.VoxelVolume(), cut.ConnectivityChanged);
     AddFieldValue(output, names::TotalSeconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     this->UpdateProgress(1.0);
     return 1;
@@ -140,5 +145,7 @@ void vtkVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Bins: " << this->Bins << "\n"
      << indent << "Sigma: " << this->Sigma << "\n"
      << indent << "Lambda: " << this->Lambda << "\n"
+     << indent << "Connectivity: " << this->Connectivity << "\n"
+     << indent << "Bandwidth: " << this->Bandwidth << "\n"
      << indent << "SeedRadius: " << this->SeedRadius << "\n";
 }

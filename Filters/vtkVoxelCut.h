@@ -31,6 +31,12 @@ public:
   /// Region-term weight lambda.
   vtkSetMacro(Lambda, double);
   vtkGetMacro(Lambda, double);
+  /// What the seeds reach (featuremesh::Connectivity): 0 off, 1 fill holes, 2 one seeded object.
+  vtkSetClampMacro(Connectivity, int, 0, 2);
+  vtkGetMacro(Connectivity, int);
+  /// Kernel bandwidth of the seed histograms as a multiple of Silverman's rule (default 1).
+  vtkSetMacro(Bandwidth, double);
+  vtkGetMacro(Bandwidth, double);
   /// Radius (voxels) of the neighbourhood around each seed whose voxels build the histograms. Default 2.
   vtkSetMacro(SeedRadius, double);
   vtkGetMacro(SeedRadius, double);
@@ -50,6 +56,8 @@ protected:
   int Bins;
   double Sigma;
   double Lambda;
+  int Connectivity;
+  double Bandwidth;
   double SeedRadius;
 
 private:

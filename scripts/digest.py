@@ -1,10 +1,11 @@
 """Digests of every stage's output on every case (pvpython): the check behind "same results".
 
-usage: pvpython scripts/digest.py [--cases a,b] [--out FILE]
+usage: pvpython scripts/digest.py [--cases a,b] [--out FILE] [--cut Lambda=1,Connectivity=0]
 For each case (bundled Data/ and ../shared/data/cases) prints one line per output: the SHA-256 of
 the node points and arrays, of the mesh (points, cells, every cell array by value), of the
 super-voxel labels (cells and label image) and of the voxel cut's labels, at the default
-properties; 3D cases also with the CGAL backend. Compare two runs with diff.
+properties (--cut overrides properties of both cuts, e.g. the defaults of an older commit); 3D cases
+also with the CGAL backend. Compare two runs with diff.
 """
 import argparse
 import hashlib
@@ -38,7 +39,9 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--cases", default="")
     ap.add_argument("--out")
+    ap.add_argument("--cut", default="", help="cut properties, e.g. Lambda=1,Connectivity=0")
     args = ap.parse_args()
+    cut_properties = {k: int(v) if v.isdigit() else float(v) for k, v in (p.split("=") for p in args.cut.split(",") if p)}
     fm.load_plugin()
     lines = []
     for name, d in fm.cases([c for c in args.cases.split(",") if c]).items():
@@ -53,10 +56,10 @@ def main():
             tag = "%s/%s" % (name, "CGAL" if backend else "default")
             lines.append("%s mesh %s" % (tag, sha(fm.v2n(m.GetPoints().GetData()), fm.v2n(m.GetCells().GetConnectivityArray()),
                                                   *[cell_array(m, a) for a in CELL_ARRAYS])))
-            cut = case.super_voxel_cut(mesh)
+            cut = case.super_voxel_cut(mesh, **cut_properties)
             lines.append("%s labels %s" % (tag, sha(fm.v2n(fm.fetch(cut, 0).GetCellData().GetArray("Label")),
                                                     fm.v2n(fm.fetch(cut, 2).GetPointData().GetScalars()))))
-        lines.append("%s voxelcut %s" % (name, sha(fm.v2n(fm.fetch(case.voxel_cut()).GetPointData().GetScalars()))))
+        lines.append("%s voxelcut %s" % (name, sha(fm.v2n(fm.fetch(case.voxel_cut(**cut_properties)).GetPointData().GetScalars()))))
         print(lines[-1], flush=True)
     text = "\n".join(lines) + "\n"
     print(text)

@@ -2,6 +2,8 @@
 
 usage: pvpython featuremesh_segment.py IMAGE --object-seeds CSV --background-seeds CSV [--truth LABELS]
                                        [--out DIR] [--plugin FeatureMesh.so]
+                                       [--lambda L] [--connectivity off|fill|seeded] [--sigma S] [--bins B]
+The cut's options default to the Super-Voxel Cut's own defaults (see its properties in ParaView).
 Seeds: CSV files with columns x,y,z in world coordinates, or "x,y,z;x,y,z" on the command line.
 Writes DIR/<name>_mesh.vtu, _boundary.vtp, _labels.vti, _report.json and _view.png.
 """
@@ -20,6 +22,9 @@ from vtkmodules.vtkIOXML import vtkXMLImageDataWriter, vtkXMLPolyDataWriter, vtk
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
 import featuremesh as fm  # noqa: E402
 
+CONNECTIVITY = {"off": "Off", "fill": "Fill Holes", "seeded": "Seeded Object"}
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("image")
@@ -28,6 +33,13 @@ def main():
     ap.add_argument("--truth")
     ap.add_argument("--out", default="out")
     ap.add_argument("--plugin")
+    cut_options = ap.add_argument_group("Super-Voxel Cut (default: the filter's own defaults)")
+    cut_options.add_argument("--lambda", dest="lam", type=float, help="region-term weight (property Lambda)")
+    cut_options.add_argument("--connectivity", choices=sorted(CONNECTIVITY),
+                             help="off: the cut as it is; fill: fill background holes (several objects of a kind "
+                                  "stay); seeded: one object, what the object seeds reach")
+    cut_options.add_argument("--sigma", type=float, help="boundary-term sigma, 0 = automatic")
+    cut_options.add_argument("--bins", type=int, help="seed histogram bins, 0 = automatic")
     args = ap.parse_args()
     fm.load_plugin(args.plugin, ns=globals())
     os.makedirs(args.out, exist_ok=True)
@@ -44,7 +56,9 @@ def main():
     sb.UpdatePipeline()
     nodes = FeatureNodes(Input=image)
     mesh = DelaunayImageMesh(Nodes=nodes, Image=image)
-    cut = SuperVoxelCut(Mesh=mesh, ObjectSeeds=so, BackgroundSeeds=sb, Image=image)
+    options = {name: value for name, value in (("Lambda", args.lam), ("Sigma", args.sigma), ("Bins", args.bins),
+               ("Connectivity", CONNECTIVITY.get(args.connectivity))) if value is not None}
+    cut = SuperVoxelCut(Mesh=mesh, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, **options)
     for stage, proxy in (("feature_nodes", nodes), ("delaunay_image_mesh", mesh), ("super_voxel_cut", cut)):
         t = time.perf_counter()
         proxy.UpdatePipeline()
@@ -65,7 +79,11 @@ def main():
               "nodes": labelled.GetNumberOfPoints(), "elements": labelled.GetNumberOfCells(),
               "min_quality_degrees": float(quality.min()), "median_quality_degrees": float(sorted(quality)[len(quality) // 2]),
               "object_elements": int(v2n(labelled.GetCellData().GetArray("Label")).sum()),
-              "sigma": field.get("Sigma"), "flow": field.get("Flow")}
+              "lambda": cut.Lambda, "connectivity": cut.Connectivity,
+              "sigma": field.get("Sigma"), "flow": field.get("Flow"),
+              "object_components": int(field.get("ObjectComponents", 0)),
+              # World units (the image spacing's unit, squared in 2D, cubed in 3D), largest first.
+              "object_component_volumes": [float(v) for v in v2n(fd.GetArray("ObjectComponentVolumes"))]}
     if args.truth:
         truth = ps.OpenDataFile(args.truth)
         T = v2n(sm.Fetch(truth).GetPointData().GetScalars()).astype(bool)
@@ -99,8 +117,11 @@ def main():
     ps.SaveScreenshot(base + "_view.png", view)
     for suffix in ("_mesh.vtu", "_boundary.vtp", "_labels.vti", "_report.json", "_view.png"):
         print("wrote", base + suffix)
+    volumes = report["object_component_volumes"]
     print("stage seconds:", ", ".join("%s %.3f" % kv for kv in times.items()), "| nodes %d, elements %d%s" % (
         report["nodes"], report["elements"], ", Dice %.3f" % report["dice"] if "dice" in report else ""))
+    print("object: %d component(s), volumes %s%s" % (len(volumes), ", ".join("%.4g" % v for v in volumes[:5]),
+                                                    ", ..." if len(volumes) > 5 else ""))
 
 
 if __name__ == "__main__":

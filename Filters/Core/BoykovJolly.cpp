@@ -49,11 +49,15 @@ std::string ValidateParameters(const BoykovJollyParameters& p)
   {
     return "lambda must lie in [0, 1e6].";
   }
+  if (!(p.Bandwidth > 0.0 && p.Bandwidth <= 100.0))
+  {
+    return "the bandwidth factor must lie in (0, 100].";
+  }
   return std::string();
 }
 
 std::vector<double> SmoothedHistogram(
-  const std::vector<double>& s, const std::vector<double>& w, double low, double high, int bins)
+  const std::vector<double>& s, const std::vector<double>& w, double low, double high, int bins, double bandwidth)
 {
   std::vector<double> hist(bins, 0.0);
   const double width = (high - low) / bins;
@@ -80,7 +84,7 @@ std::vector<double> SmoothedHistogram(
   const double sd = std::sqrt(var / total);
   // Silverman's rule with the unweighted sample count: weights say how much a sample counts, not
   // how many independent draws it is.
-  const double h = std::max(1.0, 1.06 * sd * std::pow(static_cast<double>(s.size()), -0.2) / width);
+  const double h = std::max(1.0, bandwidth * 1.06 * sd * std::pow(static_cast<double>(s.size()), -0.2) / width);
   const int radius = static_cast<int>(std::ceil(3.0 * h));
   double sum = 0.0;
   for (int b = 0; b < bins; ++b)
@@ -245,9 +249,9 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   {
     high = low + 1.0;
   }
-  const std::vector<double> pObject = SmoothedHistogram(pr.ObjectSamples, pr.ObjectWeights, low, high, r.Bins);
+  const std::vector<double> pObject = SmoothedHistogram(pr.ObjectSamples, pr.ObjectWeights, low, high, r.Bins, par.Bandwidth);
   const std::vector<double> pBackground =
-    SmoothedHistogram(pr.BackgroundSamples, pr.BackgroundWeights, low, high, r.Bins);
+    SmoothedHistogram(pr.BackgroundSamples, pr.BackgroundWeights, low, high, r.Bins, par.Bandwidth);
   std::vector<double> costObject(r.Bins), costBackground(r.Bins);
   for (int b = 0; b < r.Bins; ++b)
   {

@@ -27,8 +27,11 @@ struct BoykovJollyParameters
   // Boundary-term sigma (intensity units); 0 = automatic: the root mean square of the intensity
   // differences over all graph edges.
   double Sigma = 0.0;
-  // Weight of the region term against the boundary term (per voxel against per voxel face).
-  double Lambda = 1.0;
+  // Weight of the region term against the boundary term (per voxel against per voxel face). 0.2
+  // has the best mean Dice of both cuts over the shared cases (README, "The cut's energy").
+  double Lambda = 0.2;
+  // Kernel bandwidth of the seed histograms as a multiple of Silverman's rule.
+  double Bandwidth = 1.0;
 };
 
 struct CutProblem
@@ -55,6 +58,10 @@ struct CutResult
   double Sigma = 0.0;
   int Bins = 0;
   double GraphSeconds = 0.0, FlowSeconds = 0.0;
+  // Filled by the cuts after their connectivity rule: nodes the rule relabelled, and the object
+  // components' sizes in voxels, largest first.
+  std::int64_t ConnectivityChanged = 0;
+  std::vector<double> ObjectComponentVoxels;
   std::string Error;
   bool Aborted = false;
 };
@@ -64,7 +71,7 @@ std::string ValidateParameters(const BoykovJollyParameters& p);
 // Probability density of each histogram bin from weighted samples (Silverman bandwidth, at least
 // one bin), on [low, high]; mixed with 1 % uniform.
 std::vector<double> SmoothedHistogram(const std::vector<double>& samples, const std::vector<double>& weights,
-  double low, double high, int bins);
+  double low, double high, int bins, double bandwidth = 1.0);
 
 // Every input is checked first (finite values within +-1e150, non-negative sizes and contacts,
 // edges naming nodes): a problem is an Error sentence, never a NaN in a capacity. Running out of

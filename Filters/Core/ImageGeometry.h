@@ -31,6 +31,11 @@ struct ImageGeometry
   {
     return (static_cast<std::int64_t>(k) * Dims[1] + j) * Dims[0] + i;
   }
+  // World area (2D) or volume (3D) of one voxel.
+  double VoxelVolume() const
+  {
+    return std::fabs(Spacing[0] * Spacing[1]) * (Is2D() ? 1.0 : std::fabs(Spacing[2]));
+  }
   std::int64_t SliceStride() const { return static_cast<std::int64_t>(Dims[0]) * Dims[1]; }
   bool Contains(int i, int j, int k) const
   {

@@ -39,6 +39,28 @@ bool SeedConstraints(const std::vector<std::int64_t>& owner, const std::vector<s
   return true;
 }
 
+void SeedNeighbourhoodSamples(const double* values, const ImageGeometry& g,
+  const std::vector<std::int64_t>& seedVoxels, double radius, std::vector<double>& samples)
+{
+  const int r = static_cast<int>(std::floor(radius));
+  const int rk = g.Is2D() ? 0 : r;
+  for (std::int64_t v : seedVoxels)
+  {
+    const int k = static_cast<int>(v / g.SliceStride());
+    const int j = static_cast<int>((v % g.SliceStride()) / g.Dims[0]);
+    const int i = static_cast<int>(v % g.Dims[0]);
+    for (int dk = -rk; dk <= rk; ++dk)
+      for (int dj = -r; dj <= r; ++dj)
+        for (int di = -r; di <= r; ++di)
+        {
+          if (di * di + dj * dj + dk * dk <= radius * radius && g.Contains(i + di, j + dj, k + dk))
+          {
+            samples.push_back(values[g.Index(i + di, j + dj, k + dk)]);
+          }
+        }
+  }
+}
+
 std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale)
 {
   const FaceAdjacency& adj = mesh.Faces();
@@ -91,13 +113,22 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<dou
   if (voxelValues)
   {
     const std::int64_t n = mesh.Geometry().Size();
-    for (std::int64_t v = 0; v < n; ++v)
+    if (parameters.SampleSeedElements)
     {
-      const std::int64_t e = owner[v];
-      if (e >= 0 && pr.Hard[e])
+      for (std::int64_t v = 0; v < n; ++v)
       {
-        (pr.Hard[e] == 1 ? pr.ObjectSamples : pr.BackgroundSamples).push_back(voxelValues[v]);
+        const std::int64_t e = owner[v];
+        if (e >= 0 && pr.Hard[e])
+        {
+          (pr.Hard[e] == 1 ? pr.ObjectSamples : pr.BackgroundSamples).push_back(voxelValues[v]);
+        }
       }
+    }
+    else
+    {
+      SeedNeighbourhoodSamples(voxelValues, mesh.Geometry(), objectVoxels, parameters.SeedRadius, pr.ObjectSamples);
+      SeedNeighbourhoodSamples(
+        voxelValues, mesh.Geometry(), backgroundVoxels, parameters.SeedRadius, pr.BackgroundSamples);
     }
     if (parameters.VoxelRegionTerm)
     {
@@ -125,6 +156,14 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<dou
     result.Error = result.Cut.Error;
     return result;
   }
+  std::vector<std::uint8_t> border(m, 0);
+  for (std::int64_t e : adj.HullElement)
+  {
+    border[e] = 1;
+  }
+  result.Cut.ConnectivityChanged =
+    ApplyConnectivity(parameters.Connectivity, result.Cut.Label, adj.A, adj.B, pr.Hard, border);
+  result.Cut.ObjectComponentVoxels = ObjectComponentSizes(result.Cut.Label, adj.A, adj.B, voxelCount);
   result.BoundaryFaces = LabelBoundaryFaces(mesh, result.Cut.Label);
   return result;
 }
@@ -142,7 +181,7 @@ std::vector<std::uint8_t> VoxelLabels(const std::vector<std::int64_t>& owner, co
   return out;
 }
 
-std::string ValidateParameters(const VoxelCutParameters& p)
+std::string ValidateParameters(const SeededCutParameters& p)
 {
   std::string error = ValidateParameters(static_cast<const BoykovJollyParameters&>(p));
   if (error.empty() && !(p.SeedRadius >= 0.0 && p.SeedRadius <= 50.0))
@@ -174,29 +213,8 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
     }
     pr.Hard[v] = 2;
   }
-  // Seed neighbourhoods: voxels within SeedRadius of each seed voxel.
-  const double radius = parameters.SeedRadius;
-  const int r = static_cast<int>(std::floor(radius));
-  auto gather = [&](const std::vector<std::int64_t>& voxels, std::vector<double>& samples) {
-    for (std::int64_t v : voxels)
-    {
-      const int k = static_cast<int>(v / g.SliceStride());
-      const int j = static_cast<int>((v % g.SliceStride()) / g.Dims[0]);
-      const int i = static_cast<int>(v % g.Dims[0]);
-      const int rk = g.Is2D() ? 0 : r;
-      for (int dk = -rk; dk <= rk; ++dk)
-        for (int dj = -r; dj <= r; ++dj)
-          for (int di = -r; di <= r; ++di)
-          {
-            if (di * di + dj * dj + dk * dk <= radius * radius && g.Contains(i + di, j + dj, k + dk))
-            {
-              samples.push_back(pr.Value[g.Index(i + di, j + dj, k + dk)]);
-            }
-          }
-    }
-  };
-  gather(objectVoxels, pr.ObjectSamples);
-  gather(backgroundVoxels, pr.BackgroundSamples);
+  SeedNeighbourhoodSamples(pr.Value.data(), g, objectVoxels, parameters.SeedRadius, pr.ObjectSamples);
+  SeedNeighbourhoodSamples(pr.Value.data(), g, backgroundVoxels, parameters.SeedRadius, pr.BackgroundSamples);
   const std::int64_t sx = 1, sy = g.Dims[0], sz = g.SliceStride();
   const std::int64_t edges = (g.Dims[0] - 1) * std::int64_t(g.Dims[1]) * g.Dims[2] +
     std::int64_t(g.Dims[0]) * (g.Dims[1] - 1) * g.Dims[2] + (g.Is2D() ? 0 : sz * (g.Dims[2] - 1));
@@ -231,6 +249,30 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
       }
   }
   // Size and Contact stay empty: 1 for every voxel and every voxel face.
-  return BoykovJollyCut(pr, parameters, SubProgress(progress, 0.1, 1.0));
+  CutResult cut = BoykovJollyCut(pr, parameters, SubProgress(progress, 0.1, 0.95));
+  if (!cut.Error.empty() || cut.Aborted || !progress(0.95))
+  {
+    cut.Aborted = cut.Error.empty();
+    return cut;
+  }
+  std::vector<std::uint8_t> border(n, 0);
+  for (int k = 0; k < g.Dims[2]; ++k)
+    for (int j = 0; j < g.Dims[1]; ++j)
+      for (int i = 0; i < g.Dims[0]; ++i)
+      {
+        border[g.Index(i, j, k)] = i == 0 || j == 0 || i + 1 == g.Dims[0] || j + 1 == g.Dims[1] ||
+          (!g.Is2D() && (k == 0 || k + 1 == g.Dims[2]));
+      }
+  cut.ConnectivityChanged = ApplyConnectivity(
+    parameters.Connectivity, cut.Label, pr.A, pr.B, pr.Hard, border, SubProgress(progress, 0.95, 0.98));
+  if (cut.ConnectivityChanged < 0)
+  {
+    CutResult aborted;
+    aborted.Aborted = true;
+    return aborted;
+  }
+  cut.ObjectComponentVoxels = ObjectComponentSizes(cut.Label, pr.A, pr.B, std::vector<double>());
+  cut.Aborted = !progress(1.0);
+  return cut;
 }
 } // namespace featuremesh

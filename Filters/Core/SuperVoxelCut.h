@@ -5,6 +5,7 @@
 
 #include "BoykovJolly.h"
 #include "Parallel.h"
+#include "SeedConnectivity.h"
 #include "SimplexMesh.h"
 
 #include <cstdint>
@@ -13,7 +14,16 @@
 
 namespace featuremesh
 {
-struct SuperVoxelCutParameters : BoykovJollyParameters
+// What both cuts share besides the energy.
+struct SeededCutParameters : BoykovJollyParameters
+{
+  // The rule applied to the cut's labels (SeedConnectivity.h).
+  featuremesh::Connectivity Connectivity = featuremesh::Connectivity::FillHoles;
+  // Radius (voxels) of the neighbourhood of each seed whose voxels build the histograms.
+  double SeedRadius = 2.0;
+};
+
+struct SuperVoxelCutParameters : SeededCutParameters
 {
   // Boundary weights scaled by the shared edge length / face area in voxel-face units: the
   // element energy is then the voxel cut's energy on super-voxels, so lambda and sigma mean the
@@ -22,13 +32,13 @@ struct SuperVoxelCutParameters : BoykovJollyParameters
   // With voxel values given: an element's region cost is the sum of its voxels' costs rather than
   // its voxel count times the cost of its mean.
   bool VoxelRegionTerm = true;
+  // The histograms' samples: the voxels of the elements that hold seeds (true), or those within
+  // SeedRadius of each seed voxel, as the voxel cut (false).
+  bool SampleSeedElements = true;
 };
 
-struct VoxelCutParameters : BoykovJollyParameters
+struct VoxelCutParameters : SeededCutParameters
 {
-  // Radius (voxels) of the neighbourhood of each seed whose voxels build the histograms: about the
-  // voxels of a seed element of the super-voxel cut.
-  double SeedRadius = 2.0;
 };
 
 struct SuperVoxelCutResult
@@ -74,5 +84,9 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& geometry,
   const VoxelCutParameters& parameters, const ProgressFunction& progress = NoProgress());
 
 // Empty when usable, else a sentence.
-std::string ValidateParameters(const VoxelCutParameters& p);
+std::string ValidateParameters(const SeededCutParameters& p);
+
+// Appends to `samples` the values of the voxels within `radius` (voxels) of each seed voxel.
+void SeedNeighbourhoodSamples(const double* values, const ImageGeometry& geometry,
+  const std::vector<std::int64_t>& seedVoxels, double radius, std::vector<double>& samples);
 } // namespace featuremesh

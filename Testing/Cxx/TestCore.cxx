@@ -8,6 +8,7 @@
 #include "Halftoning.h"
 #include "ImageFilters.h"
 #include "SimplexMesh.h"
+#include "SeedConnectivity.h"
 #include "SuperVoxelCut.h"
 
 #include <gtest/gtest.h>
@@ -16,6 +17,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -1049,4 +1051,54 @@ TEST(Delaunay, QualityRefinementRaisesTheMinimumDihedralAngle)
   const double before = smallest(a), after = smallest(b);
   EXPECT_GT(after, before);
   EXPECT_GT(after, 5.0);
+}
+
+TEST(SeedConnectivity, ComponentsAreNumberedInNodeOrder)
+{
+  // A chain 0-1-2-3-4-5 with labels 1 1 0 1 0 0, edges listed backwards.
+  const std::vector<std::uint8_t> label = { 1, 1, 0, 1, 0, 0 };
+  const std::vector<std::int64_t> A = { 4, 3, 2, 1, 0 }, B = { 5, 4, 3, 2, 1 };
+  std::int64_t count = 0;
+  const std::vector<std::int64_t> id = LabelComponents(label, A, B, count);
+  EXPECT_EQ(count, 4);
+  EXPECT_EQ(id, (std::vector<std::int64_t>{ 0, 0, 1, 2, 3, 3 }));
+  EXPECT_EQ(ObjectComponentSizes(label, A, B, { 1, 2, 4, 8, 16, 32 }), (std::vector<double>{ 8, 3 }));
+}
+
+TEST(SeedConnectivity, VoxelCutKeepsWhatTheSeedsReachAndFillsHoles)
+{
+  // Two bright disks; the right one has a dark hole. One object seed, in the left disk.
+  ImageGeometry g;
+  g.Dims = { { 64, 32, 1 } };
+  std::vector<double> values(g.Size());
+  auto inside = [](int i, int j, int ci, double r) { return (i - ci) * (i - ci) + (j - 16) * (j - 16) <= r * r; };
+  for (int j = 0; j < 32; ++j)
+    for (int i = 0; i < 64; ++i)
+      values[g.Index(i, j, 0)] = (inside(i, j, 16, 9) || (inside(i, j, 48, 9) && !inside(i, j, 48, 3))) ? 100.0 : 0.0;
+  const std::vector<std::int64_t> object = { g.Index(16, 16, 0) }, background = { g.Index(1, 1, 0) };
+  auto cut = [&](Connectivity mode) {
+    VoxelCutParameters p;
+    p.Connectivity = mode;
+    p.Lambda = 1.0;
+    const CutResult r = VoxelCut(values, g, object, background, p);
+    EXPECT_TRUE(r.Error.empty()) << r.Error;
+    return r;
+  };
+  const CutResult off = cut(Connectivity::Off), fill = cut(Connectivity::FillHoles),
+                  seeded = cut(Connectivity::SeededObject);
+  const std::int64_t left = g.Index(16, 20, 0), ring = g.Index(48, 22, 0), hole = g.Index(48, 16, 0);
+  EXPECT_EQ(off.Label[left], 1);
+  EXPECT_EQ(off.Label[ring], 1);
+  EXPECT_EQ(off.Label[hole], 0);
+  EXPECT_EQ(off.ObjectComponentVoxels.size(), 2u);
+  EXPECT_EQ(off.ConnectivityChanged, 0);
+  EXPECT_EQ(fill.Label[ring], 1);
+  EXPECT_EQ(fill.Label[hole], 1);
+  EXPECT_EQ(fill.ConnectivityChanged, 29); // the hole: the lattice points within radius 3
+  EXPECT_EQ(seeded.Label[left], 1);
+  EXPECT_EQ(seeded.Label[ring], 0);
+  EXPECT_EQ(seeded.Label[hole], 0);
+  ASSERT_EQ(seeded.ObjectComponentVoxels.size(), 1u);
+  EXPECT_EQ(seeded.ObjectComponentVoxels[0], off.ObjectComponentVoxels[0]);
+  EXPECT_EQ(seeded.Label[background[0]], 0);
 }

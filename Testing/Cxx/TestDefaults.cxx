@@ -44,8 +44,11 @@ int main(int argc, char* argv[])
     GETTER(vtkDelaunayImageMesh, RadiusEdgeRatio), GETTER(vtkDelaunayImageMesh, MinDihedralAngle),
     GETTER(vtkSuperVoxelCut, Lambda), GETTER(vtkSuperVoxelCut, Sigma), GETTER(vtkSuperVoxelCut, Bins),
     GETTER(vtkSuperVoxelCut, ScaleByContact), GETTER(vtkSuperVoxelCut, VoxelRegionTerm),
+    GETTER(vtkSuperVoxelCut, Connectivity), GETTER(vtkSuperVoxelCut, Bandwidth),
+    GETTER(vtkSuperVoxelCut, SampleSeedElements), GETTER(vtkSuperVoxelCut, SeedRadius),
+    GETTER(vtkSuperVoxelCut, SuperVoxelIds),
     GETTER(vtkVoxelCut, Lambda), GETTER(vtkVoxelCut, Sigma), GETTER(vtkVoxelCut, Bins),
-    GETTER(vtkVoxelCut, SeedRadius),
+    GETTER(vtkVoxelCut, SeedRadius), GETTER(vtkVoxelCut, Connectivity), GETTER(vtkVoxelCut, Bandwidth),
   };
   int failures = 0, checked = 0;
   std::set<std::string> seen;

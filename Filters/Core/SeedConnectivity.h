@@ -1,0 +1,42 @@
+// What the seeds reach: connected components of a labelled graph (mesh elements sharing a face,
+// voxels sharing a face) and the connectivity rule applied after either cut.
+#pragma once
+
+#include "Parallel.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace featuremesh
+{
+enum class Connectivity : int
+{
+  // The cut's labels as they are: every object component the energy prefers is kept.
+  Off = 0,
+  // Background components that hold no background seed and touch no image border become object:
+  // a hole inside the object is object. Unseeded object components are kept (several objects of
+  // one kind, such as nuclei or cells, stay labelled with a few seeds).
+  FillHoles = 1,
+  // One object: object components that hold no object seed become background, then holes are
+  // filled as above.
+  SeededObject = 2,
+};
+
+// Components of equal label over the edges A[i]-B[i]: an id per node, numbered in order of each
+// component's first node (deterministic); `count` receives their number.
+std::vector<std::int64_t> LabelComponents(
+  const std::vector<std::uint8_t>& label, const std::vector<std::int64_t>& A, const std::vector<std::int64_t>& B,
+  std::int64_t& count);
+
+// Applies `mode` to `label` (1 object, 0 background) in place; `hard` (0 free, 1 object seed, 2
+// background seed) and `border` (node touches the image border) per node. Seeded nodes keep their
+// label. Returns how many nodes changed, or -1 when `progress` (asked between passes) aborts.
+std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label,
+  const std::vector<std::int64_t>& A, const std::vector<std::int64_t>& B, const std::vector<std::uint8_t>& hard,
+  const std::vector<std::uint8_t>& border, const ProgressFunction& progress = NoProgress());
+
+// The sizes of the object components (sum of `size` over their nodes, 1 per node when `size` is
+// empty), largest first.
+std::vector<double> ObjectComponentSizes(const std::vector<std::uint8_t>& label, const std::vector<std::int64_t>& A,
+  const std::vector<std::int64_t>& B, const std::vector<double>& size);
+} // namespace featuremesh
