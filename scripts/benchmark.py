@@ -1,9 +1,24 @@
-"""FeatureMesh benchmark (pvpython): full pipeline vs the classical voxel cut on every case.
+"""FeatureMesh benchmark (pvpython): the segmentation against the voxel cut and seeded peers, and the
+mesh as super-pixels against SLIC, on every case.
 
 usage: pvpython scripts/benchmark.py [--runs 3] [--cases a,b] [--out out/benchmark]
+                                     [--no-slic] [--no-peers] [--lambdas 0.1,0.2,0.5]
 Cases: the bundled Data/ ones and every case in ../shared/data/cases (skipped with a message when
-absent). Prints one table (median of --runs runs per stage; the voxel cut runs once per case when it
-takes over 5 s) and writes it as Markdown and CSV.
+absent). Everything runs at the filters' defaults on each case's seed files.
+
+Segmentation table: Dice and seconds of the pipeline (median of --runs fresh runs per stage), the
+voxel cut (once when it takes over 5 s), scikit-image's random walker (image mapped to [0, 1] by its
+0.5/99.5 percentiles, so that one beta means the same on every image: 2e5, featuremesh.metrics; over 2 M voxels on 2 x 2 x 2
+block means, random_walker_scale 2) and a seeded watershed on
+the gradient magnitude (sigma 1 voxel) of that image; the peers get the same seed voxels.
+
+Super-pixel table: the mesh's elements as super-pixels (K, oracle Dice = each element takes its
+majority reference label, ASA, boundary recall within 1 voxel) and SLIC at the same K: each
+compactness of 0.01/0.03/0.1/0.3 (on the [0, 1] image) runs near K, the best by oracle Dice runs
+again on the other side of K and the scores are interpolated to K.
+
+--lambdas adds a table of the Super-Voxel Cut's and the Voxel Cut's Dice over lambda, for each
+connectivity rule, on the same meshes. Writes OUT.md and OUT.csv (and OUT_lambda.csv).
 """
 import argparse
 import csv
@@ -13,75 +28,172 @@ import statistics
 import sys
 import time
 
+import numpy as np
 from paraview import servermanager as sm
-from paraview.simple import *  # noqa: F401,F403
 import paraview.simple as ps
 from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
 import featuremesh as fm  # noqa: E402
-from featuremesh import dice, seeds  # noqa: E402
+from featuremesh import metrics  # noqa: E402
 
-ROOT = fm.ROOT
+CONNECTIVITY = {0: "off", 1: "fill", 2: "seeded"}
+
+
+def field(data, name):
+    a = data.GetFieldData().GetArray(name)
+    return v2n(a) if a is not None else np.zeros(0)
+
+
+def seed_indices(case, image):
+    """Voxel (i, j, k) of every seed of the case (the shared data have identity directions)."""
+    origin, spacing = np.array(image.GetOrigin()), np.array(image.GetSpacing())
+    out = []
+    for name in ("seeds_object.csv", "seeds_background.csv"):
+        pts = np.loadtxt(os.path.join(case.folder, name), delimiter=",", skiprows=1, ndmin=2)
+        out.append(np.rint((pts - origin) / spacing).astype(int))
+    return out
+
+
+def timed(proxy):
+    t = time.perf_counter()
+    proxy.UpdatePipeline()
+    return time.perf_counter() - t
+
+
+def run_case(case, args):
+    T = case.truth()
+    image = fm.fetch(case.image)
+    dims, spacing = image.GetDimensions(), image.GetSpacing()
+    shape = dims[::-1]
+    truth = T.reshape(shape).astype(bool)
+    # Fresh proxies every run: re-executing a proxy would only measure ParaView's cache.
+    times = {"nodes": [], "mesh": [], "cut": []}
+    for _ in range(args.runs):
+        nodes = case.feature_nodes()
+        mesh = case.mesh(nodes)
+        cut = case.super_voxel_cut(mesh)
+        case.object_seeds.UpdatePipeline()
+        case.background_seeds.UpdatePipeline()
+        for key, proxy in (("nodes", nodes), ("mesh", mesh), ("cut", cut)):
+            times[key].append(timed(proxy))
+    labelled = fm.fetch(cut, 0)
+    L = fm.labels(cut)
+    vt = []
+    for _ in range(args.runs):
+        vc = case.voxel_cut()
+        vt.append(timed(vc))
+        if vt[-1] > 5:
+            break
+    V = fm.labels(vc, 0)
+    med = {k: statistics.median(v) for k, v in times.items()}
+    total = sum(med.values())
+    q = v2n(labelled.GetCellData().GetArray("MinAngle") or labelled.GetCellData().GetArray("MinDihedralAngle"))
+    row = {"case": case.name, "voxels": T.size, "elements": labelled.GetNumberOfCells(),
+           "elements_with_voxels": int((v2n(labelled.GetCellData().GetArray("PixelCount")) > 0).sum()),
+           "nodes_s": med["nodes"], "mesh_s": med["mesh"], "cut_s": med["cut"], "total_s": total,
+           "voxel_cut_s": statistics.median(vt), "speedup": statistics.median(vt) / total,
+           "dice_supervoxel": fm.dice(L, T), "dice_voxel": fm.dice(V, T),
+           "components": int(field(labelled, "ObjectComponents")[0]), "min_quality_deg": float(q.min())}
+    unit = metrics.unit_range(v2n(image.GetPointData().GetScalars()).reshape(shape))
+    if not args.no_peers:
+        obj, bg = seed_indices(case, image)
+        markers = metrics.seed_markers(shape, obj, bg)
+        for key, peer in (("random_walker", metrics.random_walker_peer), ("watershed", metrics.watershed_peer)):
+            mask, seconds, scale = peer(unit, markers, spacing)
+            row["dice_" + key] = fm.dice(mask.ravel(), T)
+            row[key + "_s"] = seconds
+            if key == "random_walker":
+                row["random_walker_scale"] = scale
+    if not args.no_slic:
+        ids = case.super_voxel_cut(mesh, SuperVoxelIds=1)
+        owner = v2n(fm.fetch(ids, 2).GetPointData().GetArray("ElementId")).reshape(shape)
+        owner = np.where(owner < 0, owner.max() + 1, owner)
+        mine = metrics.partition_scores(owner, truth)
+        ps.Delete(ids)
+        slic = metrics.slic_at_count(unit, truth, mine["K"], spacing)
+        row.update({"K": mine["K"], "oracle_dice_mesh": mine["oracle_dice"], "oracle_dice_slic": slic["oracle_dice"],
+                    "asa_mesh": mine["asa"], "asa_slic": slic["asa"],
+                    "boundary_recall_mesh": mine["boundary_recall"], "boundary_recall_slic": slic["boundary_recall"],
+                    "slic_compactness": slic["compactness"], "slic_bracket": "%s-%s" % slic["bracket"],
+                    "slic_s": slic["seconds"]})
+    lam_rows = []
+    for lam in args.lambdas:
+        r = {"case": case.name, "lambda": lam}
+        for mode, tag in CONNECTIVITY.items():
+            c = case.super_voxel_cut(mesh, Lambda=lam, Connectivity=mode)
+            r["supervoxel_" + tag] = fm.dice(fm.labels(c), T)
+            ps.Delete(c)
+            v = case.voxel_cut(Lambda=lam, Connectivity=mode)
+            r["voxel_" + tag] = fm.dice(fm.labels(v, 0), T)
+            ps.Delete(v)
+        lam_rows.append(r)
+        print("  lambda %g: %s" % (lam, " ".join("%s %.3f" % (k, v) for k, v in r.items() if k.startswith(("super", "voxel")))), flush=True)
+    return row, lam_rows
+
+
+def markdown(rows, keys):
+    lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
+    for r in rows:
+        lines.append("| " + " | ".join(("%.3f" % r[k]) if isinstance(r.get(k), float) else str(r.get(k, "")) for k in keys) + " |")
+    if rows and len(rows) > 1:
+        means = {k: float(np.mean([r[k] for r in rows if isinstance(r.get(k), float)])) for k in keys
+                 if all(isinstance(r.get(k), float) for r in rows) and not k.endswith(("_s", "compactness"))}
+        lines.append("| mean | " + " | ".join(("%.3f" % means[k]) if k in means else "" for k in keys[1:]) + " |")
+    return lines
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--cases", default="")
-    ap.add_argument("--out", default=os.path.join(ROOT, "out", "benchmark"))
+    ap.add_argument("--out", default=os.path.join(fm.ROOT, "out", "benchmark"))
+    ap.add_argument("--no-slic", action="store_true", help="skip the super-pixel table")
+    ap.add_argument("--no-peers", action="store_true", help="skip the random walker and watershed")
+    ap.add_argument("--lambdas", default="", help="comma-separated lambdas for the lambda table")
     args = ap.parse_args()
-    fm.load_plugin(ns=globals())
-    rows = []
-    for name, d in fm.cases([c for c in args.cases.split(",") if c]).items():
-        image = ps.OpenDataFile(os.path.join(d, "image.mha"))
-        image.UpdatePipeline()
-        scalars = image.PointData.keys()[0]
-        so, sb = seeds(os.path.join(d, "seeds_object.csv")), seeds(os.path.join(d, "seeds_background.csv"))
-        T = v2n(sm.Fetch(ps.OpenDataFile(os.path.join(d, "truth.mha"))).GetPointData().GetScalars())
-        # Fresh proxies every run: re-executing a proxy would only measure ParaView's cache.
-        times = {"nodes": [], "mesh": [], "cut": []}
-        for _ in range(args.runs):
-            nodes = FeatureNodes(Input=image, Scalars=["POINTS", scalars])
-            mesh = DelaunayImageMesh(Nodes=nodes, Image=image, Scalars=["POINTS", scalars])
-            cut = SuperVoxelCut(Mesh=mesh, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, Scalars=["POINTS", scalars])
-            so.UpdatePipeline()
-            sb.UpdatePipeline()
-            for key, proxy in (("nodes", nodes), ("mesh", mesh), ("cut", cut)):
-                t = time.perf_counter()
-                proxy.UpdatePipeline()
-                times[key].append(time.perf_counter() - t)
-        labelled = sm.Fetch(cut, idx=0)
-        L = v2n(sm.Fetch(cut, idx=2).GetPointData().GetScalars())
-        vt = []
-        for _ in range(args.runs):
-            vc = VoxelCut(Input=image, ObjectSeeds=so, BackgroundSeeds=sb, Scalars=["POINTS", scalars])
-            t = time.perf_counter()
-            vc.UpdatePipeline()
-            vt.append(time.perf_counter() - t)
-            if vt[-1] > 5:
-                break
-        V = v2n(sm.Fetch(vc).GetPointData().GetScalars())
-        med = {k: statistics.median(v) for k, v in times.items()}
-        total = sum(med.values())
-        q = v2n(labelled.GetCellData().GetArray("MinAngle") or labelled.GetCellData().GetArray("MinDihedralAngle"))
-        row = {"case": name, "voxels": T.size, "nodes": labelled.GetNumberOfPoints(), "elements": labelled.GetNumberOfCells(),
-               "nodes_s": med["nodes"], "mesh_s": med["mesh"], "cut_s": med["cut"], "total_s": total,
-               "voxel_cut_s": statistics.median(vt), "speedup": statistics.median(vt) / total,
-               "dice_supervoxel": dice(L, T), "dice_voxel": dice(V, T), "min_quality_deg": float(q.min())}
+    args.lambdas = [float(v) for v in args.lambdas.split(",") if v]
+    fm.load_plugin()
+    selection = [c for c in args.cases.split(",") if c]
+    found = fm.cases(selection)
+    if not os.path.isdir(os.path.join(fm.SHARED, "cases")):
+        print("shared data not found at %s: only the bundled cases run" % fm.SHARED)
+    rows, lam_rows = [], []
+    for name, d in found.items():
+        case = fm.Case(d)
+        if case.truth() is None:
+            print("%s: no truth.mha, skipped" % name)
+            continue
+        row, lr = run_case(case, args)
         rows.append(row)
+        lam_rows += lr
         print(" | ".join("%s %s" % (k, ("%.3f" % v) if isinstance(v, float) else v) for k, v in row.items()), flush=True)
     os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
-    keys = list(rows[0].keys()) if rows else []
+    keys = list(dict.fromkeys(k for r in rows for k in r))
     with open(args.out + ".csv", "w", newline="") as f:
         w = csv.DictWriter(f, keys)
         w.writeheader()
         w.writerows(rows)
     machine = "%s, %d cores, %s" % (platform.machine(), os.cpu_count(), platform.platform())
+    seg = [k for k in keys if k in ("case", "voxels", "elements", "total_s", "voxel_cut_s", "speedup", "components",
+                                    "min_quality_deg") or k.startswith("dice_") or k.endswith(("walker_s", "shed_s", "_scale"))]
+    sp = [k for k in keys if k == "case" or k == "K" or k.startswith(("oracle_", "asa_", "boundary_", "slic_"))]
     lines = ["Machine: %s; medians of %d runs (voxel cut: once when over 5 s)." % (machine, args.runs), "",
-             "| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
-    for r in rows:
-        lines.append("| " + " | ".join(("%.3f" % r[k]) if isinstance(r[k], float) else str(r[k]) for k in keys) + " |")
+             "## Segmentation (Dice at the defaults)", ""] + markdown(rows, seg)
+    if len(sp) > 1:
+        lines += ["", "## The mesh as super-pixels, against SLIC at the same K", ""] + markdown(rows, sp)
+    if lam_rows:
+        lkeys = list(lam_rows[0].keys())
+        with open(args.out + "_lambda.csv", "w", newline="") as f:
+            w = csv.DictWriter(f, lkeys)
+            w.writeheader()
+            w.writerows(lam_rows)
+        lines += ["", "## Dice over lambda (connectivity off / fill holes / seeded object)", ""]
+        lines += markdown(lam_rows, lkeys)[:-1] if len(lam_rows) > 1 else markdown(lam_rows, lkeys)
+        means = ["| mean over cases, lambda %g | " % lam + " | ".join(
+            "%.3f" % np.mean([r[k] for r in lam_rows if r["lambda"] == lam]) for k in lkeys[2:]) + " |"
+            for lam in args.lambdas]
+        lines += means
     with open(args.out + ".md", "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))

@@ -1,0 +1,35 @@
+"""The benchmark on the bundled cases (the shared data hidden): it prints the segmentation table with
+the peer columns and the super-pixel table, and its figures are consistent: the mesh's oracle Dice
+bounds every labelling of its elements, the super-voxel cut's included; scores lie in [0, 1]; the
+SLIC runs bracket K."""
+import csv
+import os
+import shutil
+import subprocess
+import tempfile
+
+import fmtest as ft
+
+out = os.path.join(tempfile.mkdtemp(), "bench")
+env = dict(os.environ, FEATUREMESH_SHARED_DATA=os.path.join(out, "absent"))
+script = os.path.join(ft.fm.ROOT, "scripts", "benchmark.py")
+run = subprocess.run([shutil.which("pvpython"), script, "--runs", "1", "--out", out], env=env, capture_output=True, text=True)
+print(run.stdout[-3000:])
+ft.check(run.returncode == 0, "benchmark.py exits 0 (stderr: %s)" % run.stderr[-500:])
+ft.check("## The mesh as super-pixels" in run.stdout and "dice_random_walker" in run.stdout and "dice_watershed" in run.stdout,
+         "the printed tables hold the super-pixel table and the peer columns")
+rows = list(csv.DictReader(open(out + ".csv"))) if os.path.isfile(out + ".csv") else []
+ft.check(sorted(r["case"] for r in rows) == ["liver-ct-totalseg", "nuclei-dsb2018"], "both bundled cases in the CSV")
+for r in rows:
+    v = {k: float(x) for k, x in r.items() if k not in ("case", "slic_bracket")}
+    scores = [v[k] for k in v if k.startswith(("dice_", "oracle_", "asa_", "boundary_recall_"))]
+    ft.check(all(0.0 <= s <= 1.0 for s in scores), "%s: every score in [0, 1]" % r["case"])
+    ft.check(v["oracle_dice_mesh"] >= v["dice_supervoxel"] - 1e-9,
+             "%s: the mesh's oracle Dice %.3f bounds the super-voxel cut's %.3f" % (r["case"], v["oracle_dice_mesh"], v["dice_supervoxel"]))
+    ft.check(v["K"] == v["elements_with_voxels"] <= v["elements"],
+             "%s: K %d = the elements owning voxels (%d of %d)" % (r["case"], v["K"], v["elements_with_voxels"], v["elements"]))
+    low, high = (int(x) if x != "None" else None for x in r["slic_bracket"].split("-"))
+    ft.check(low is not None and high is not None and low <= v["K"] <= high,
+             "%s: SLIC runs bracket K (%s)" % (r["case"], r["slic_bracket"]))
+    ft.check(v["components"] >= 1, "%s: object components reported" % r["case"])
+print("all benchmark checks passed")
