@@ -79,7 +79,7 @@ def main():
               "nodes": labelled.GetNumberOfPoints(), "elements": labelled.GetNumberOfCells(),
               "min_quality_degrees": float(quality.min()), "median_quality_degrees": float(sorted(quality)[len(quality) // 2]),
               "object_elements": int(v2n(labelled.GetCellData().GetArray("Label")).sum()),
-              "lambda": cut.Lambda, "connectivity": cut.Connectivity,
+              "lambda": float(cut.Lambda), "connectivity": cut.GetProperty("Connectivity").GetData(),
               "sigma": field.get("Sigma"), "flow": field.get("Flow"),
               "object_components": int(field.get("ObjectComponents", 0)),
               # World units (the image spacing's unit, squared in 2D, cubed in 3D), largest first.
