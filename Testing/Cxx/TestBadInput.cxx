@@ -835,6 +835,28 @@ TEST(SuperVoxelCut, HugeLambda)
   SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "lambda"); },
     [](vtkSuperVoxelCut* f) { f->SetLambda(1e300); });
 }
+TEST(SuperVoxelCut, ZeroBandwidth)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "bandwidth"); },
+    [](vtkSuperVoxelCut* f) { f->SetBandwidth(0); });
+}
+TEST(SuperVoxelCut, SeedRadiusOutOfRange)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "seed radius"); },
+    [](vtkSuperVoxelCut* f) {
+      f->SampleSeedElementsOff();
+      f->SetSeedRadius(-1);
+    });
+}
+TEST(SuperVoxelCut, SeededObjectKeepsTheSeeds)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image,
+    [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, c.image, c.object, c.background); },
+    [](vtkSuperVoxelCut* f) { f->SetConnectivity(2); });
+}
 TEST(SuperVoxelCut, ZeroLambdaIsBoundaryOnly)
 {
   Case2D c;
@@ -922,6 +944,12 @@ TEST(VoxelCut, SeedRadiusOutOfRange)
   auto image = Disc();
   VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "seed radius", out); },
     [](vtkVoxelCut* f) { f->SetSeedRadius(1000); });
+}
+TEST(VoxelCut, NegativeBandwidth)
+{
+  auto image = Disc();
+  VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "bandwidth", out); },
+    [](vtkVoxelCut* f) { f->SetBandwidth(-1); });
 }
 TEST(VoxelCut, TinySigmaKeepsTheSeeds)
 {
