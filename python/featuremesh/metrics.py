@@ -81,12 +81,16 @@ def unit_range(image):
     return np.clip((image.astype(np.float32) - lo) / (hi - lo), 0.0, 1.0)
 
 
+def _skimage_spacing(volume, spacing):
+    """Spacing (x, y, z) in the axis order of _squeeze(volume): (y, x) or (z, y, x)."""
+    sp = np.asarray(spacing, float)
+    return sp[:2][::-1] if volume.shape[0] == 1 else sp[::-1]
+
+
 def _slic(unit, n, compactness, spacing):
     from skimage.segmentation import slic
-    image = unit[0] if unit.shape[0] == 1 else unit
-    sp = spacing[:2][::-1] if unit.shape[0] == 1 else spacing[::-1]
-    s = slic(image, n_segments=int(n), compactness=compactness, channel_axis=None, start_label=0,
-             spacing=np.asarray(sp, float), enforce_connectivity=True)
+    s = slic(_squeeze(unit), n_segments=int(n), compactness=compactness, channel_axis=None, start_label=0,
+             spacing=_skimage_spacing(unit, spacing), enforce_connectivity=True)
     return s.reshape(unit.shape)
 
 
@@ -180,8 +184,8 @@ def random_walker_peer(unit, markers, spacing):
         z, y, x = np.nonzero(markers)
         seeds[z // (scale if unit.shape[0] > 1 else 1), y // scale, x // scale] = markers[z, y, x]
         sp = sp * scale
-    sp = sp[:2][::-1] if unit.shape[0] == 1 else sp[::-1]
-    r = random_walker(_squeeze(image), _squeeze(seeds), beta=RANDOM_WALKER_BETA, mode="cg_j", tol=1e-3, spacing=sp)
+    r = random_walker(_squeeze(image), _squeeze(seeds), beta=RANDOM_WALKER_BETA, mode="cg_j", tol=1e-3,
+                      spacing=_skimage_spacing(image, sp))
     r = r.reshape(image.shape) == 1
     if scale > 1:
         r = r.repeat(scale, 0).repeat(scale, 1).repeat(scale, 2)[: unit.shape[0], : unit.shape[1], : unit.shape[2]]
