@@ -231,36 +231,7 @@ int vtkDelaunayImageMesh::RequestData(
 
     // Node arrays pass through; added nodes get NodeType Added and Fixed 1 (corners) or 0 (refinement).
     const vtkIdType nPts = mesh.NumberOfPoints();
-    vtkPointData* inPD = nodes->GetPointData();
-    vtkPointData* outPD = output->GetPointData();
-    outPD->CopyAllocate(inPD, nPts);
-    for (vtkIdType i = 0; i < nIn; ++i)
-    {
-      outPD->CopyData(inPD, i, i);
-    }
-    for (vtkIdType i = nIn; i < nPts; ++i)
-    {
-      outPD->NullData(i);
-    }
-    auto setAdded = [&](const char* name, int corner, int steiner) {
-      vtkDataArray* a = outPD->GetArray(name);
-      if (!a)
-      {
-        vtkNew<vtkUnsignedCharArray> created;
-        created->SetName(name);
-        created->SetNumberOfTuples(nPts);
-        created->Fill(0);
-        outPD->AddArray(created);
-        a = created;
-      }
-      for (vtkIdType i = nIn; i < nPts; ++i)
-      {
-        a->SetComponent(i, 0, i < firstSteiner ? corner : steiner);
-      }
-    };
-    const int added = static_cast<int>(NodeType::Added);
-    setAdded(names::NodeType, added, added);
-    setAdded(names::Fixed, 1, 0);
+    PassNodeArrays(nodes->GetPointData(), nIn, output->GetPointData(), nPts, firstSteiner);
 
     AddFieldValue(output, names::AddedNodes, static_cast<double>(nPts - nIn));
     AddFieldValue(output, names::DelaunayBackend, is2D || this->Backend == CGAL ? 1.0 : 0.0);

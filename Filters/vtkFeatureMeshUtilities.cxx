@@ -351,6 +351,38 @@ void WriteImageMesh(const SimplexMesh& mesh, const ElementStatistics& stats, con
   AddImageGeometry(mesh.Geometry(), output);
 }
 
+void PassNodeArrays(vtkPointData* in, vtkIdType nIn, vtkPointData* out, vtkIdType nOut, vtkIdType firstSteiner)
+{
+  out->CopyAllocate(in, nOut);
+  for (vtkIdType i = 0; i < nIn; ++i)
+  {
+    out->CopyData(in, i, i);
+  }
+  for (vtkIdType i = nIn; i < nOut; ++i)
+  {
+    out->NullData(i);
+  }
+  auto setAdded = [&](const char* name, int corner, int steiner) {
+    vtkDataArray* a = out->GetArray(name);
+    if (!a)
+    {
+      vtkNew<vtkUnsignedCharArray> created;
+      created->SetName(name);
+      created->SetNumberOfTuples(nOut);
+      created->Fill(0);
+      out->AddArray(created);
+      a = created;
+    }
+    for (vtkIdType i = nIn; i < nOut; ++i)
+    {
+      a->SetComponent(i, 0, i < firstSteiner ? corner : steiner);
+    }
+  };
+  const int added = static_cast<int>(NodeType::Added);
+  setAdded(names::NodeType, added, added);
+  setAdded(names::Fixed, 1, 0);
+}
+
 void RequestWholeImage(vtkInformationVector* portVector)
 {
   for (int c = 0; c < portVector->GetNumberOfInformationObjects(); ++c)

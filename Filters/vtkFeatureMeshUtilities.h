@@ -22,6 +22,7 @@ class vtkDataArray;
 class vtkImageData;
 class vtkInformation;
 class vtkInformationVector;
+class vtkPointData;
 class vtkPointSet;
 class vtkUnstructuredGrid;
 
@@ -118,6 +119,11 @@ bool ToSimplexMesh(vtkUnstructuredGrid* grid, const ImageGeometry& geometry, Sim
 // coordinates), the statistics and quality cell arrays, the image frame and summary field data.
 void WriteImageMesh(const SimplexMesh& mesh, const ElementStatistics& statistics, const std::vector<double>& minAngle,
   const std::vector<double>& radiusRatio, vtkUnstructuredGrid* output);
+
+// Point arrays of a mesh whose first nIn points are the nodes of `in`: copied for those, and for the
+// nOut - nIn points added after them NodeType Added and Fixed 1 (ids below firstSteiner: box
+// corners) or 0 (refinement), other arrays zero.
+void PassNodeArrays(vtkPointData* in, vtkIdType nIn, vtkPointData* out, vtkIdType nOut, vtkIdType firstSteiner);
 
 // Sets the update extent of every image connected to `port` to its whole extent.
 void RequestWholeImage(vtkInformationVector* portVector);

@@ -3,6 +3,7 @@
 usage: pvpython scripts/digest.py [--cases a,b] [--out FILE] [--cut Lambda=1,Connectivity=0]
 For each case (bundled Data/ and ../shared/data/cases) prints one line per output: the SHA-256 of
 the node points and arrays, of the mesh (points, cells, every cell array by value), of the
+smoothed mesh (stage 3 at its defaults, default backend), of the
 super-voxel labels (cells and label image) and of the voxel cut's labels, at the default
 properties (--cut overrides properties of both cuts, e.g. the defaults of an older commit); 3D cases
 also with the CGAL backend. Compare two runs with diff.
@@ -59,6 +60,11 @@ def main():
             cut = case.super_voxel_cut(mesh, **cut_properties)
             lines.append("%s labels %s" % (tag, sha(fm.v2n(fm.fetch(cut, 0).GetCellData().GetArray("Label")),
                                                     fm.v2n(fm.fetch(cut, 2).GetPointData().GetScalars()))))
+            if backend == 0:
+                smoothed = case.smoothing(mesh)
+                s = fm.fetch(smoothed)
+                lines.append("%s smoothed %s" % (tag, sha(fm.v2n(s.GetPoints().GetData()), fm.v2n(s.GetCells().GetConnectivityArray()),
+                                                          *[cell_array(s, a) for a in CELL_ARRAYS])))
         lines.append("%s voxelcut %s" % (name, sha(fm.v2n(fm.fetch(case.voxel_cut(**cut_properties)).GetPointData().GetScalars()))))
         print(lines[-1], flush=True)
     text = "\n".join(lines) + "\n"

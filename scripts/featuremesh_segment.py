@@ -1,8 +1,9 @@
-"""FeatureMesh main job (pvpython / pvbatch): image + seeds -> nodes -> mesh -> super-voxel cut.
+"""FeatureMesh main job (pvpython / pvbatch): image + seeds -> nodes -> mesh -> smoothed mesh -> super-voxel cut.
 
 usage: pvpython featuremesh_segment.py IMAGE --object-seeds CSV --background-seeds CSV [--truth LABELS]
                                        [--out DIR] [--plugin FeatureMesh.so]
                                        [--lambda L] [--connectivity off|fill|seeded] [--sigma S] [--bins B]
+                                       [--no-smoothing]
 The cut's options default to the Super-Voxel Cut's own defaults (see its properties in ParaView).
 Seeds: CSV files with columns x,y,z in world coordinates, or "x,y,z;x,y,z" on the command line.
 Writes DIR/<name>_mesh.vtu, _boundary.vtp, _labels.vti, _report.json and _view.png.
@@ -21,8 +22,13 @@ from vtkmodules.vtkIOXML import vtkXMLImageDataWriter, vtkXMLPolyDataWriter, vtk
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
 import featuremesh as fm  # noqa: E402
+from featuremesh import metrics  # noqa: E402
 
 CONNECTIVITY = {"off": "Off", "fill": "Fill Holes", "seeded": "Seeded Object"}
+
+
+def cells_of(grid):
+    return v2n(grid.GetCells().GetConnectivityArray()).reshape(grid.GetNumberOfCells(), -1)
 
 
 def main():
@@ -40,6 +46,7 @@ def main():
                                   "stay); seeded: one object, what the object seeds reach")
     cut_options.add_argument("--sigma", type=float, help="boundary-term sigma, 0 = automatic")
     cut_options.add_argument("--bins", type=int, help="seed histogram bins, 0 = automatic")
+    ap.add_argument("--no-smoothing", action="store_true", help="cut the Delaunay mesh (skip Image Mesh Smoothing)")
     args = ap.parse_args()
     fm.load_plugin(args.plugin, ns=globals())
     os.makedirs(args.out, exist_ok=True)
@@ -55,11 +62,14 @@ def main():
     so.UpdatePipeline()
     sb.UpdatePipeline()
     nodes = FeatureNodes(Input=image)
-    mesh = DelaunayImageMesh(Nodes=nodes, Image=image)
+    delaunay = DelaunayImageMesh(Nodes=nodes, Image=image)
+    mesh = delaunay if args.no_smoothing else ImageMeshSmoothing(Mesh=delaunay, Image=image)
     options = {name: value for name, value in (("Lambda", args.lam), ("Sigma", args.sigma), ("Bins", args.bins),
                ("Connectivity", CONNECTIVITY.get(args.connectivity))) if value is not None}
     cut = SuperVoxelCut(Mesh=mesh, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, **options)
-    for stage, proxy in (("feature_nodes", nodes), ("delaunay_image_mesh", mesh), ("super_voxel_cut", cut)):
+    stages = [("feature_nodes", nodes), ("delaunay_image_mesh", delaunay)]
+    stages += [] if args.no_smoothing else [("image_mesh_smoothing", mesh)]
+    for stage, proxy in stages + [("super_voxel_cut", cut)]:
         t = time.perf_counter()
         proxy.UpdatePipeline()
         times[stage] = time.perf_counter() - t
@@ -75,9 +85,15 @@ def main():
     fd = labelled.GetFieldData()
     field = {fd.GetArrayName(i): fd.GetArray(i).GetValue(0) for i in range(fd.GetNumberOfArrays()) if fd.GetArray(i) is not None}
     quality = v2n(labelled.GetCellData().GetArray("MinAngle") or labelled.GetCellData().GetArray("MinDihedralAngle"))
+    raw = sm.Fetch(delaunay)
+    angles = {"delaunay": metrics.mesh_quality(v2n(raw.GetPoints().GetData()), cells_of(raw)),
+              "final": metrics.mesh_quality(v2n(labelled.GetPoints().GetData()), cells_of(labelled))}
     report = {"image": os.path.abspath(args.image), "seconds": times, "total_seconds": sum(v for k, v in times.items() if k != "read"),
               "nodes": labelled.GetNumberOfPoints(), "elements": labelled.GetNumberOfCells(),
               "min_quality_degrees": float(quality.min()), "median_quality_degrees": float(sorted(quality)[len(quality) // 2]),
+              # Minimum, 1st percentile of the element minima, maximum: angles (2D) or dihedral angles (3D).
+              "angles_degrees": angles, "smoothing": not args.no_smoothing,
+              "added_nodes": int(field.get("AddedNodes", 0)) if not args.no_smoothing else 0,
               "object_elements": int(v2n(labelled.GetCellData().GetArray("Label")).sum()),
               "lambda": float(cut.Lambda), "connectivity": cut.GetProperty("Connectivity").GetData(),
               "sigma": field.get("Sigma"), "flow": field.get("Flow"),
@@ -120,6 +136,9 @@ def main():
     volumes = report["object_component_volumes"]
     print("stage seconds:", ", ".join("%s %.3f" % kv for kv in times.items()), "| nodes %d, elements %d%s" % (
         report["nodes"], report["elements"], ", Dice %.3f" % report["dice"] if "dice" in report else ""))
+    print("mesh quality (%s angles, deg): Delaunay min %.2f / 1st pct %.2f / max %.2f -> %s min %.2f / 1st pct %.2f / max %.2f" % (
+        "dihedral" if dims[2] > 1 else "element", angles["delaunay"]["min"], angles["delaunay"]["p1"], angles["delaunay"]["max"],
+        "Delaunay" if args.no_smoothing else "smoothed", angles["final"]["min"], angles["final"]["p1"], angles["final"]["max"]))
     print("object: %d component(s), volumes %s%s" % (len(volumes), ", ".join("%.4g" % v for v in volumes[:5]),
                                                     ", ..." if len(volumes) > 5 else ""))
 

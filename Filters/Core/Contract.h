@@ -56,6 +56,17 @@ constexpr const char* DelaunayBackend = "DelaunayBackend"; // 0 TetGen, 1 CGAL (
 constexpr const char* DelaunaySeconds = "DelaunaySeconds";
 constexpr const char* StatisticsSeconds = "StatisticsSeconds";
 constexpr const char* TotalSeconds = "TotalSeconds";
+// Stage 3: quality of the input mesh, what the smoothing did, its time.
+constexpr const char* MinAngleBefore = "MinAngleBefore";
+constexpr const char* MinDihedralAngleBefore = "MinDihedralAngleBefore";
+constexpr const char* IterationsRun = "IterationsRun";
+constexpr const char* SmoothingMoves = "SmoothingMoves";
+constexpr const char* EdgeFlips = "EdgeFlips";
+constexpr const char* SliverMoves = "SliverMoves";
+constexpr const char* SmoothingSeconds = "SmoothingSeconds";
+constexpr const char* SweepSeconds = "SweepSeconds";
+constexpr const char* RefinementSeconds = "RefinementSeconds";
+constexpr const char* SliverSeconds = "SliverSeconds";
 constexpr const char* Sigma = "Sigma";
 constexpr const char* Bins = "Bins";
 constexpr const char* Flow = "Flow";

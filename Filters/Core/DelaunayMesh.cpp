@@ -1,5 +1,10 @@
 #include "DelaunayMesh.h"
 
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Delaunay_mesh_criteria_2.h>
+#include <CGAL/Delaunay_mesh_face_base_2.h>
+#include <CGAL/Delaunay_mesh_vertex_base_2.h>
+#include <CGAL/Delaunay_mesher_2.h>
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -12,6 +17,7 @@
 #include <cstdio>
 #include <exception>
 #include <numeric>
+#include <set>
 #include <utility>
 
 namespace featuremesh
@@ -205,7 +211,7 @@ DelaunayResult TetrahedralizeTetGen(const std::vector<std::array<double, 3>>& po
       in.facetmarkerlist[f] = f + 1;
     }
     char buffer[64];
-    std::snprintf(buffer, sizeof(buffer), "pq%g/%g", o.RadiusEdgeRatio, o.MinDihedralAngle);
+    std::snprintf(buffer, sizeof(buffer), "pq%g/%g%s", o.RadiusEdgeRatio, o.MinDihedralAngle, o.PreserveBoundary ? "Y" : "");
     switches += buffer;
   }
   std::vector<char> sw(switches.begin(), switches.end());
@@ -324,6 +330,84 @@ DelaunayResult Triangulate2D(const std::vector<std::array<double, 3>>& points)
       for (int v = 0; v < 3; ++v)
       {
         r.Cells.push_back(f->vertex(v)->info());
+      }
+    }
+  }
+  catch (const std::exception& e)
+  {
+    r = DelaunayResult();
+    r.Error = std::string("CGAL failed: ") + e.what();
+  }
+  return r;
+}
+
+DelaunayResult RefineQuality2D(const std::vector<std::array<double, 3>>& points, double minAngle)
+{
+  using Vb = CGAL::Triangulation_vertex_base_with_info_2<std::int64_t, K, CGAL::Delaunay_mesh_vertex_base_2<K>>;
+  using Fb = CGAL::Delaunay_mesh_face_base_2<K>;
+  using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
+  using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
+  using Criteria = CGAL::Delaunay_mesh_criteria_2<CDT>;
+  DelaunayResult r;
+  try
+  {
+    CDT cdt;
+    double lo[2] = { points[0][0], points[0][1] }, hi[2] = { lo[0], lo[1] };
+    for (const auto& p : points)
+    {
+      for (int a = 0; a < 2; ++a)
+      {
+        lo[a] = std::min(lo[a], p[a]);
+        hi[a] = std::max(hi[a], p[a]);
+      }
+    }
+    std::vector<CDT::Vertex_handle> handle(points.size());
+    for (size_t i = 0; i < points.size(); ++i)
+    {
+      handle[i] = cdt.insert(K::Point_2(points[i][0], points[i][1]));
+      handle[i]->info() = static_cast<std::int64_t>(i);
+    }
+    // The box boundary: constrained segments between consecutive points on each side.
+    for (int side = 0; side < 4; ++side)
+    {
+      const int axis = side / 2, other = 1 - axis;
+      const double at = side % 2 ? hi[axis] : lo[axis];
+      std::vector<std::pair<double, size_t>> on;
+      for (size_t i = 0; i < points.size(); ++i)
+      {
+        if (points[i][axis] == at)
+        {
+          on.emplace_back(points[i][other], i);
+        }
+      }
+      std::sort(on.begin(), on.end());
+      for (size_t k = 1; k < on.size(); ++k)
+      {
+        cdt.insert_constraint(handle[on[k - 1].second], handle[on[k].second]);
+      }
+    }
+    const double s = std::sin(std::min(minAngle, 20.7) * 3.14159265358979323846 / 180.0);
+    CGAL::refine_Delaunay_mesh_2(cdt, Criteria(s * s));
+    // The mesher only adds vertices: the input's handles stay valid.
+    const std::set<CDT::Vertex_handle> input(handle.begin(), handle.end());
+    r.Points = points;
+    for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
+    {
+      if (!input.count(v))
+      {
+        v->info() = static_cast<std::int64_t>(r.Points.size());
+        r.Points.push_back({ { v->point().x(), v->point().y(), 0.0 } });
+      }
+    }
+    r.VerticesPerCell = 3;
+    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f)
+    {
+      if (f->is_in_domain())
+      {
+        for (int v = 0; v < 3; ++v)
+        {
+          r.Cells.push_back(f->vertex(v)->info());
+        }
       }
     }
   }

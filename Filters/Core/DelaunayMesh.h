@@ -22,6 +22,9 @@ struct DelaunayOptions
   bool QualityRefinement = false;
   double RadiusEdgeRatio = 2.0;
   double MinDihedralAngle = 10.0;
+  // Refinement adds no node on the box faces (TetGen -Y): fewer nodes, where nodes near a face
+  // would otherwise split it finely.
+  bool PreserveBoundary = false;
 };
 
 struct DelaunayResult
@@ -38,6 +41,12 @@ struct DelaunayResult
 // tetrahedra with det[b-a, c-a, d-a] > 0.
 DelaunayResult Triangulate2D(const std::vector<std::array<double, 3>>& points);
 DelaunayResult Tetrahedralize(const std::vector<std::array<double, 3>>& points, const DelaunayOptions& options);
+
+// Delaunay refinement of a mesh of the points over their bounding box (the box's faces are the
+// domain boundary; every point is kept, at its index): 2D CGAL Delaunay_mesher_2 to a minimum angle
+// of `minAngle` degrees (at most 20.7, its termination bound), 3D TetGen to `options`' radius-edge
+// ratio and minimum dihedral angle. Added points follow the input points.
+DelaunayResult RefineQuality2D(const std::vector<std::array<double, 3>>& points, double minAngle);
 
 // True when the points span an area (dimension 2, xy) or a volume (dimension 3); exact predicates.
 bool SpansDimension(const std::vector<std::array<double, 3>>& points, int dimension);

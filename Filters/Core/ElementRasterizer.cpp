@@ -14,7 +14,8 @@ ElementRasterizer::ElementRasterizer(const SimplexMesh& mesh)
   }
 }
 
-double InterpolateAt(const double* values, const ImageGeometry& g, const double index[3])
+template <typename T>
+double InterpolateAt(const T* values, const ImageGeometry& g, const double index[3])
 {
   int base[3];
   double t[3];
@@ -46,6 +47,8 @@ double InterpolateAt(const double* values, const ImageGeometry& g, const double 
   }
   return result;
 }
+template double InterpolateAt<double>(const double*, const ImageGeometry&, const double[3]);
+template double InterpolateAt<float>(const float*, const ImageGeometry&, const double[3]);
 
 ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, const double* values,
   const ParallelFor& parallel, const ProgressFunction& progress)
@@ -137,6 +140,41 @@ double Norm(const V3& a)
 constexpr double Degrees = 180.0 / 3.14159265358979323846;
 } // namespace
 
+double SimplexMinAngle(const V3* const* v, int vpc)
+{
+  double smallest = 180.0;
+  if (vpc == 3)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      const V3 u = Sub(*v[(k + 1) % 3], *v[k]), w = Sub(*v[(k + 2) % 3], *v[k]);
+      smallest = std::min(smallest, std::atan2(Norm(Cross(u, w)), Dot(u, w)) * Degrees);
+    }
+    return smallest;
+  }
+  // Face normals, each pointing away from its opposite vertex; face f is opposite vertex f.
+  V3 n[4];
+  for (int f = 0; f < 4; ++f)
+  {
+    n[f] = Cross(Sub(*v[(f + 2) % 4], *v[(f + 1) % 4]), Sub(*v[(f + 3) % 4], *v[(f + 1) % 4]));
+    if (Dot(n[f], Sub(*v[f], *v[(f + 1) % 4])) > 0)
+    {
+      n[f] = { { -n[f][0], -n[f][1], -n[f][2] } };
+    }
+  }
+  for (int k = 0; k < 4; ++k)
+  {
+    for (int l = k + 1; l < 4; ++l)
+    {
+      // Dihedral angle at the edge shared by faces k and l: pi minus the normals' angle.
+      const double norms = Norm(n[k]) * Norm(n[l]);
+      const double cosine = norms > 0 ? -Dot(n[k], n[l]) / norms : 1.0;
+      smallest = std::min(smallest, std::acos(std::max(-1.0, std::min(1.0, cosine))) * Degrees);
+    }
+  }
+  return smallest;
+}
+
 void ElementQuality(const SimplexMesh& mesh, std::vector<double>& minAngle, std::vector<double>& radiusRatio,
   const ParallelFor& parallel)
 {
@@ -154,14 +192,8 @@ void ElementQuality(const SimplexMesh& mesh, std::vector<double>& minAngle, std:
         const V3 &a = P[id[0]], &bb = P[id[1]], &d = P[id[2]];
         const double la = Norm(Sub(bb, d)), lb = Norm(Sub(a, d)), lc = Norm(Sub(a, bb));
         const double area = 0.5 * Norm(Cross(Sub(bb, a), Sub(d, a)));
-        double smallest = 180.0;
         const V3* v[3] = { &a, &bb, &d };
-        for (int k = 0; k < 3; ++k)
-        {
-          const V3 u = Sub(*v[(k + 1) % 3], *v[k]), w = Sub(*v[(k + 2) % 3], *v[k]);
-          smallest = std::min(smallest, std::atan2(Norm(Cross(u, w)), Dot(u, w)) * Degrees);
-        }
-        minAngle[c] = smallest;
+        minAngle[c] = SimplexMinAngle(v, 3);
         const double s = 0.5 * (la + lb + lc);
         const double r = area / s, R = la * lb * lc / (4.0 * area);
         radiusRatio[c] = area > 0 ? 2.0 * r / R : 0.0;
@@ -169,30 +201,12 @@ void ElementQuality(const SimplexMesh& mesh, std::vector<double>& minAngle, std:
       else
       {
         const V3* v[4] = { &P[id[0]], &P[id[1]], &P[id[2]], &P[id[3]] };
-        // Face normals (any consistent sense); face f is opposite vertex f.
-        V3 n[4];
         double faceArea = 0.0;
         for (int f = 0; f < 4; ++f)
         {
-          n[f] = Cross(Sub(*v[(f + 2) % 4], *v[(f + 1) % 4]), Sub(*v[(f + 3) % 4], *v[(f + 1) % 4]));
-          // Point every normal away from its opposite vertex (outward).
-          if (Dot(n[f], Sub(*v[f], *v[(f + 1) % 4])) > 0)
-          {
-            n[f] = { { -n[f][0], -n[f][1], -n[f][2] } };
-          }
-          faceArea += 0.5 * Norm(n[f]);
+          faceArea += 0.5 * Norm(Cross(Sub(*v[(f + 2) % 4], *v[(f + 1) % 4]), Sub(*v[(f + 3) % 4], *v[(f + 1) % 4])));
         }
-        double smallest = 180.0;
-        for (int k = 0; k < 4; ++k)
-        {
-          for (int l = k + 1; l < 4; ++l)
-          {
-            // Dihedral angle at the edge shared by faces k and l: pi minus the normals' angle.
-            const double cosine = -Dot(n[k], n[l]) / (Norm(n[k]) * Norm(n[l]));
-            smallest = std::min(smallest, std::acos(std::max(-1.0, std::min(1.0, cosine))) * Degrees);
-          }
-        }
-        minAngle[c] = smallest;
+        minAngle[c] = SimplexMinAngle(v, 4);
         const V3 a = Sub(*v[1], *v[0]), bb = Sub(*v[2], *v[0]), d = Sub(*v[3], *v[0]);
         const double det = Dot(a, Cross(bb, d));
         const double volume = std::fabs(det) / 6.0;

@@ -76,8 +76,13 @@ std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const Par
 void ElementQuality(const SimplexMesh& mesh, std::vector<double>& minAngle, std::vector<double>& radiusRatio,
   const ParallelFor& parallel);
 
-// Trilinear (bilinear in 2D) interpolation of voxel values at a continuous index.
-double InterpolateAt(const double* values, const ImageGeometry& grid, const double index[3]);
+// Minimum angle (triangle) or minimum dihedral angle (tetrahedron) in degrees of the element with
+// vertices v[0..vpc) (any orientation; 0 for a flat one).
+double SimplexMinAngle(const std::array<double, 3>* const* v, int verticesPerCell);
+
+// Trilinear (bilinear in 2D) interpolation of voxel values at a continuous index (T double or float).
+template <typename T>
+double InterpolateAt(const T* values, const ImageGeometry& grid, const double index[3]);
 
 //------------------------------------------------------------------------------------------------
 // Inline: called once per candidate voxel centre.

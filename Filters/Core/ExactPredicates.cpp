@@ -18,4 +18,11 @@ int Orientation2(const std::array<double, 3>& a, const std::array<double, 3>& b,
   return static_cast<int>(
     CGAL::orientation(K::Point_2(a[0], a[1]), K::Point_2(b[0], b[1]), K::Point_2(c[0], c[1])));
 }
+
+int InCircle(const std::array<double, 3>& a, const std::array<double, 3>& b, const std::array<double, 3>& c,
+  const std::array<double, 3>& d)
+{
+  return static_cast<int>(CGAL::side_of_oriented_circle(
+    K::Point_2(a[0], a[1]), K::Point_2(b[0], b[1]), K::Point_2(c[0], c[1]), K::Point_2(d[0], d[1])));
+}
 } // namespace featuremesh

@@ -11,4 +11,8 @@ int Orientation3(const std::array<double, 3>& a, const std::array<double, 3>& b,
   const std::array<double, 3>& d);
 // Sign of the cross product (b - a) x (c - a) in the xy plane, exactly.
 int Orientation2(const std::array<double, 3>& a, const std::array<double, 3>& b, const std::array<double, 3>& c);
+// +1 when d lies inside the circle through the counter-clockwise triangle a, b, c (xy plane), 0 on
+// it, -1 outside; exactly.
+int InCircle(const std::array<double, 3>& a, const std::array<double, 3>& b, const std::array<double, 3>& c,
+  const std::array<double, 3>& d);
 } // namespace featuremesh

@@ -256,7 +256,14 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
     occupied[idx] = 1;
     out.Positions.push_back({ { i, j, k } });
     out.Type.push_back(type);
-    out.Fixed.push_back(type == NodeType::Canny || type == NodeType::Boundary ? 1 : 0);
+    // Smoothing may slide boundary nodes along the box, but never moves a corner.
+    bool corner = true;
+    const int ijk[3] = { i, j, k };
+    for (int a = 0; a < g.Dimension(); ++a)
+    {
+      corner = corner && (ijk[a] == 0 || ijk[a] == g.Dims[a] - 1);
+    }
+    out.Fixed.push_back(type == NodeType::Canny || (type == NodeType::Boundary && corner) ? 1 : 0);
     out.SampleRadius.push_back(radius);
     out.Counts[static_cast<int>(type)]++;
   };

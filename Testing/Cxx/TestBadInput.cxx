@@ -4,6 +4,7 @@
 // a time limit, so a crash or a hang fails one case, not the suite.
 #include "vtkDelaunayImageMesh.h"
 #include "vtkFeatureNodes.h"
+#include "vtkImageMeshSmoothing.h"
 #include "vtkSuperVoxelCut.h"
 #include "vtkVoxelCut.h"
 
@@ -961,4 +962,184 @@ TEST(VoxelCut, TinySigmaKeepsTheSeeds)
       EXPECT_EQ(out->GetPointData()->GetScalars()->GetComponent(30 * 32 + 30, 0), 0);
     },
     [](vtkVoxelCut* f) { f->SetSigma(1e-300); });
+}
+
+// ---- Image Mesh Smoothing ----
+namespace
+{
+template <typename Check>
+void Smoothing(vtkUnstructuredGrid* mesh, vtkImageData* image, const Check& check,
+  const std::function<void(vtkImageMeshSmoothing*)>& set = nullptr)
+{
+  Run<vtkImageMeshSmoothing> run;
+  run->SetInputData(0, mesh);
+  if (image)
+    run->SetInputData(1, image);
+  if (set)
+    set(run.F);
+  run.Update();
+  check(run, run->GetOutput());
+}
+
+// A valid smoothed mesh: PixelCount sums to the voxels, every element is positively oriented in
+// world coordinates (mirrored frames flip it: compare with the input's first element's sign).
+void ExpectSmoothed(Run<vtkImageMeshSmoothing>& run, vtkUnstructuredGrid* mesh, vtkImageData* image)
+{
+  ASSERT_TRUE(run.Log->Errors.empty()) << run.Log->All();
+  ASSERT_GT(mesh->GetNumberOfCells(), 0);
+  vtkDataArray* count = mesh->GetCellData()->GetArray("PixelCount");
+  ASSERT_NE(count, nullptr);
+  double total = 0;
+  for (vtkIdType c = 0; c < count->GetNumberOfTuples(); ++c)
+    total += count->GetComponent(c, 0);
+  EXPECT_EQ(total, static_cast<double>(image->GetNumberOfPoints()));
+  ASSERT_NE(mesh->GetPointData()->GetArray("Fixed"), nullptr);
+  EXPECT_EQ(mesh->GetPointData()->GetArray("Fixed")->GetNumberOfTuples(), mesh->GetNumberOfPoints());
+  EXPECT_NE(mesh->GetFieldData()->GetArray("IterationsRun"), nullptr);
+}
+} // namespace
+
+TEST(ImageMeshSmoothing, Disc)
+{
+  auto image = Disc();
+  Smoothing(MeshOf(image), image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectSmoothed(run, out, image); });
+}
+TEST(ImageMeshSmoothing, BallMirroredAndAnisotropic)
+{
+  auto image = Ball();
+  const double direction[9] = { -1, 0, 0, 0, 1, 0, 0, 0, 1 };
+  image->SetDirectionMatrix(direction);
+  image->SetSpacing(1.0, 1.5, 2.0);
+  Smoothing(MeshOf(image), image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectSmoothed(run, out, image); });
+}
+TEST(ImageMeshSmoothing, NoImage)
+{
+  auto image = Disc();
+  Smoothing(MeshOf(image), nullptr, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "Image input is required", out); });
+}
+TEST(ImageMeshSmoothing, EmptyMesh)
+{
+  vtkNew<vtkUnstructuredGrid> empty;
+  Smoothing(empty, Disc(), [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "empty", out); });
+}
+TEST(ImageMeshSmoothing, MeshWithoutStageTwoArrays)
+{
+  auto image = Disc();
+  auto mesh = MeshOf(image);
+  mesh->GetCellData()->RemoveArray("PixelCount");
+  Smoothing(mesh, image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "Delaunay Image Mesh", out); });
+}
+TEST(ImageMeshSmoothing, MeshWithoutFrameTakesTheImages)
+{
+  auto image = Disc();
+  auto mesh = MeshOf(image);
+  mesh->GetFieldData()->RemoveArray("ImageSpacing");
+  Smoothing(mesh, image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectSmoothed(run, out, image); });
+}
+TEST(ImageMeshSmoothing, MixedCellTypes)
+{
+  auto image = Disc();
+  auto mesh = MeshOf(image);
+  const vtkIdType vertex[1] = { 0 };
+  mesh->InsertNextCell(VTK_VERTEX, 1, vertex);
+  Smoothing(mesh, image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "mixes cell types", out); });
+}
+TEST(ImageMeshSmoothing, AnotherImageGrid)
+{
+  auto image = Disc();
+  auto mesh = MeshOf(image);
+  Smoothing(mesh, Image({ 20, 20, 1 }, Noisy(10, 10, 0, 5)),
+    [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "another image grid", out); });
+}
+TEST(ImageMeshSmoothing, TetrahedraOnA2DImage)
+{
+  auto ball = Ball();
+  auto mesh = MeshOf(ball);
+  auto disc = Disc();
+  // Give the tetrahedral mesh the disc's frame: the cell type no longer matches the dimension.
+  for (const char* name : { "ImageDimensions", "ImageSpacing", "ImageOrigin", "ImageDirection" })
+  {
+    mesh->GetFieldData()->RemoveArray(name);
+  }
+  auto discMesh = MeshOf(disc);
+  for (const char* name : { "ImageDimensions", "ImageSpacing", "ImageOrigin", "ImageDirection" })
+  {
+    mesh->GetFieldData()->AddArray(discMesh->GetFieldData()->GetArray(name));
+  }
+  Smoothing(mesh, disc, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "needs a 3D image", out); });
+}
+TEST(ImageMeshSmoothing, NaNInTheImage)
+{
+  auto image = Disc();
+  auto mesh = MeshOf(image);
+  image->GetPointData()->GetScalars()->SetComponent(5, 0, NaN);
+  Smoothing(mesh, image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "NaN", out); });
+}
+TEST(ImageMeshSmoothing, ZeroIterationsPassesTheMeshThrough)
+{
+  auto image = Disc();
+  auto mesh = MeshOf(image);
+  Smoothing(mesh, image,
+    [&](auto& run, vtkUnstructuredGrid* out) {
+      ASSERT_TRUE(run.Log->Errors.empty()) << run.Log->All();
+      ASSERT_EQ(out->GetNumberOfPoints(), mesh->GetNumberOfPoints());
+      ASSERT_EQ(out->GetNumberOfCells(), mesh->GetNumberOfCells());
+      for (vtkIdType i = 0; i < out->GetNumberOfPoints(); ++i)
+      {
+        double a[3], b[3];
+        out->GetPoint(i, a);
+        mesh->GetPoint(i, b);
+        ASSERT_TRUE(a[0] == b[0] && a[1] == b[1] && a[2] == b[2]);
+      }
+    },
+    [](vtkImageMeshSmoothing* s) { s->SetIterations(0); });
+}
+TEST(ImageMeshSmoothing, NegativeIterations)
+{
+  auto image = Disc();
+  Smoothing(MeshOf(image), image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "iterations", out); },
+    [](vtkImageMeshSmoothing* s) { s->SetIterations(-3); });
+}
+TEST(ImageMeshSmoothing, ZeroSigma)
+{
+  auto image = Disc();
+  Smoothing(MeshOf(image), image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "sigma", out); },
+    [](vtkImageMeshSmoothing* s) { s->SetSigma(0.0); });
+}
+TEST(ImageMeshSmoothing, NaNFeatureWeight)
+{
+  auto image = Disc();
+  Smoothing(MeshOf(image), image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "feature weight", out); },
+    [](vtkImageMeshSmoothing* s) { s->SetFeatureWeight(NaN); });
+}
+TEST(ImageMeshSmoothing, UnendingRefinementAngle)
+{
+  auto image = Disc();
+  Smoothing(MeshOf(image), image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "20.7", out); },
+    [](vtkImageMeshSmoothing* s) { s->SetMinAngle(35.0); });
+}
+TEST(ImageMeshSmoothing, SlackBeyondTwoVoxels)
+{
+  auto image = Disc();
+  Smoothing(MeshOf(image), image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "slack", out); },
+    [](vtkImageMeshSmoothing* s) { s->SetFixedNodeSlack(Inf); });
+}
+TEST(ImageMeshSmoothing, MeshWithoutFixedArrayMovesEveryNodeButTheCorners)
+{
+  auto image = Disc();
+  auto mesh = MeshOf(image);
+  mesh->GetPointData()->RemoveArray("Fixed");
+  Smoothing(mesh, image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectSmoothed(run, out, image); });
+}
+TEST(ImageMeshSmoothing, ConstantImage)
+{
+  auto image = Image({ 24, 20, 1 }, [](int, int, int) { return 7.0; });
+  // Feature Nodes warns and gives box nodes only; smoothing has no gradient: plain ODT.
+  vtkNew<vtkFeatureNodes> nodes;
+  nodes->SetInputData(image);
+  vtkNew<vtkDelaunayImageMesh> mesh;
+  mesh->SetInputConnection(0, nodes->GetOutputPort());
+  mesh->SetInputData(1, image);
+  mesh->Update();
+  Smoothing(mesh->GetOutput(), image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectSmoothed(run, out, image); });
 }

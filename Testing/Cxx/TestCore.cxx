@@ -7,6 +7,8 @@
 #include "FeatureNodes.h"
 #include "Halftoning.h"
 #include "ImageFilters.h"
+#include "MeshSmoothing.h"
+#include "ExactPredicates.h"
 #include "SimplexMesh.h"
 #include "SeedConnectivity.h"
 #include "SuperVoxelCut.h"
@@ -24,6 +26,7 @@
 #include <thread>
 #include <numeric>
 #include <random>
+#include <set>
 
 using namespace featuremesh;
 
@@ -1101,4 +1104,212 @@ TEST(SeedConnectivity, VoxelCutKeepsWhatTheSeedsReachAndFillsHoles)
   ASSERT_EQ(seeded.ObjectComponentVoxels.size(), 1u);
   EXPECT_EQ(seeded.ObjectComponentVoxels[0], off.ObjectComponentVoxels[0]);
   EXPECT_EQ(seeded.Label[background[0]], 0);
+}
+
+// ---- Stage 3: image mesh smoothing ----
+namespace
+{
+// A 4 x 4 square of fixed nodes (2,2)-(6,6) on a 10 x 10 grid and one free node at (3,3): four
+// triangles, areas 2 (bottom), 6 (right), 6 (top), 2 (left).
+SimplexMesh FreeNodeInSquare()
+{
+  std::vector<std::array<double, 3>> pts = { { { 2, 2, 0 } }, { { 6, 2, 0 } }, { { 6, 6, 0 } }, { { 2, 6, 0 } },
+    { { 3, 3, 0 } } };
+  std::vector<std::int64_t> cells = { 4, 0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0 };
+  return SimplexMesh(Grid2(10, 10), pts, cells, 3);
+}
+
+// A mesh tiling the box of `g` from jittered-lattice nodes (corners included) and a few clustered
+// ones, with every third interior node fixed; Delaunay (CGAL) in index space.
+SimplexMesh JitteredMesh(const ImageGeometry& g, std::vector<std::uint8_t>& fixed, unsigned seed)
+{
+  std::mt19937 rng(seed);
+  std::vector<std::array<double, 3>> pts;
+  std::set<std::array<int, 3>> used;
+  const int dim = g.Dimension();
+  for (int c = 0; c < (1 << dim); ++c)
+  {
+    std::array<int, 3> q = { { (c & 1) ? g.Dims[0] - 1 : 0, (c & 2) ? g.Dims[1] - 1 : 0, (c & 4) ? g.Dims[2] - 1 : 0 } };
+    used.insert(q);
+  }
+  for (int t = 0; t < (dim == 2 ? 120 : 220); ++t)
+  {
+    std::array<int, 3> q = { { int(rng() % g.Dims[0]), int(rng() % g.Dims[1]), dim == 2 ? 0 : int(rng() % g.Dims[2]) } };
+    used.insert(q);
+    // A close neighbour now and then: short edges, bad elements.
+    if (t % 7 == 0)
+    {
+      q[0] = std::min(q[0] + 1, g.Dims[0] - 1);
+      used.insert(q);
+    }
+  }
+  for (const auto& q : used)
+  {
+    pts.push_back({ { double(q[0]), double(q[1]), double(q[2]) } });
+  }
+  DelaunayOptions o;
+  o.Backend = DelaunayBackend::CGAL;
+  const DelaunayResult d = dim == 2 ? Triangulate2D(pts) : Tetrahedralize(pts, o);
+  EXPECT_TRUE(d.Error.empty()) << d.Error;
+  fixed.assign(pts.size(), 0);
+  for (size_t i = 0; i < pts.size(); i += 3)
+  {
+    fixed[i] = 1;
+  }
+  return SimplexMesh(g, d.Points, d.Cells, d.VerticesPerCell);
+}
+
+double MinimumAngle(const SimplexMesh& mesh)
+{
+  std::vector<double> angle, ratio;
+  ElementQuality(mesh, angle, ratio, SerialFor());
+  return *std::min_element(angle.begin(), angle.end());
+}
+} // namespace
+
+TEST(MeshSmoothing, TargetsOfOneFreeNodeMatchTheFormulas)
+{
+  const SimplexMesh mesh = FreeNodeInSquare();
+  const std::int64_t star[4] = { 0, 1, 2, 3 };
+  const double uniform[4] = { 1, 1, 1, 1 }, heavyRight[4] = { 1, 2, 1, 1 };
+  // Centroids (11/3, 7/3), (5, 11/3), (11/3, 5), (7/3, 11/3); circumcentres (4, 1), (5, 4), (4, 5),
+  // (1, 4); weights area x density.
+  auto expect = [&](const double* density, SmoothingMethod method, double x, double y) {
+    const auto t = SmoothingTarget(mesh, mesh.Points(), star, 4, density, method);
+    EXPECT_NEAR(t[0], x, 1e-12);
+    EXPECT_NEAR(t[1], y, 1e-12);
+    EXPECT_EQ(t[2], 0.0);
+  };
+  expect(uniform, SmoothingMethod::CVT, 4.0, 4.0);
+  expect(uniform, SmoothingMethod::ODT, 4.0, 4.0);
+  expect(heavyRight, SmoothingMethod::CVT, 94.0 / 22.0, 86.0 / 22.0);
+  expect(heavyRight, SmoothingMethod::ODT, 94.0 / 22.0, 88.0 / 22.0);
+
+  // Anisotropic spacing: measures and centres in frame units, the target back in index units.
+  ImageGeometry g = Grid2(10, 10);
+  g.Spacing = { { 2.0, 1.0, 1.0 } };
+  const SimplexMesh stretched(g, mesh.Points(), mesh.Cells(), 3);
+  const auto t = SmoothingTarget(stretched, stretched.Points(), star, 4, heavyRight, SmoothingMethod::CVT);
+  EXPECT_NEAR(t[0], 94.0 / 22.0, 1e-12); // centroids scale with the frame; the weights' ratios do not change
+  EXPECT_NEAR(t[1], 86.0 / 22.0, 1e-12);
+}
+
+TEST(MeshSmoothing, DensityGrowsWithTheGradientAndIsOneWhenFlat)
+{
+  const SimplexMesh mesh = FreeNodeInSquare();
+  std::vector<float> gradient(100, 0.f);
+  EXPECT_EQ(ElementDensity(mesh, mesh.Points(), 0, gradient.data(), 0.0, 1.0), 1.0);
+  std::fill(gradient.begin(), gradient.end(), 2.f);
+  // Constant g = mean: rho = 1 + w.
+  EXPECT_NEAR(ElementDensity(mesh, mesh.Points(), 1, gradient.data(), 2.0, 3.0), 4.0, 1e-12);
+  // g = x: the samples average the centroid's and the sub-triangles' x, which is the centroid's x.
+  for (int j = 0; j < 10; ++j)
+    for (int i = 0; i < 10; ++i)
+      gradient[j * 10 + i] = float(i);
+  EXPECT_NEAR(ElementDensity(mesh, mesh.Points(), 1, gradient.data(), 1.0, 1.0), 1.0 + 5.0, 1e-12);
+}
+
+TEST(MeshSmoothing, FixedNodesStayBoxNodesSlideAndTheMeshStaysValid)
+{
+  for (int dim : { 2, 3 })
+  {
+    ImageGeometry g;
+    g.Dims = dim == 2 ? std::array<int, 3>{ { 48, 40, 1 } } : std::array<int, 3>{ { 18, 16, 14 } };
+    std::vector<std::uint8_t> fixed;
+    const SimplexMesh mesh = JitteredMesh(g, fixed, 11);
+    std::vector<float> image(g.Size());
+    for (int k = 0; k < g.Dims[2]; ++k)
+      for (int j = 0; j < g.Dims[1]; ++j)
+        for (int i = 0; i < g.Dims[0]; ++i)
+          image[g.Index(i, j, k)] = std::hypot(i - 20.0, j - 17.0) < 9.0 ? 200.f : 20.f;
+    MeshSmoothingParameters p;
+    const MeshSmoothingResult r = SmoothImageMesh(mesh, fixed, image.data(), p, SerialFor());
+    ASSERT_TRUE(r.Error.empty()) << r.Error;
+    ASSERT_FALSE(r.Aborted);
+    EXPECT_EQ(r.IterationsRun, 5);
+    EXPECT_GT(r.Moves, 0);
+    const SimplexMesh& out = r.Mesh;
+    ASSERT_EQ(out.NumberOfPoints(), mesh.NumberOfPoints() + r.AddedNodes);
+    const auto& P0 = mesh.Points();
+    const auto& P1 = out.Points();
+    for (std::int64_t i = 0; i < mesh.NumberOfPoints(); ++i)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        const bool onFace = P0[i][a] == 0.0 || P0[i][a] == g.Dims[a] - 1.0;
+        if (fixed[i] || onFace)
+          ASSERT_EQ(P1[i][a], P0[i][a]) << "node " << i << " axis " << a;
+        // Moved positions sit on the 1/1024-voxel lattice inside the box.
+        ASSERT_EQ(P1[i][a] * 1024.0, std::round(P1[i][a] * 1024.0));
+        ASSERT_GE(P1[i][a], 0.0);
+        ASSERT_LE(P1[i][a], g.Dims[a] - 1.0);
+      }
+    }
+    // Every element positively oriented (exactly), measures tile the box, every centre one owner.
+    double measure = 0.0;
+    for (std::int64_t e = 0; e < out.NumberOfElements(); ++e)
+    {
+      const std::int64_t* c = out.Cell(e);
+      const int sign = dim == 2 ? Orientation2(P1[c[0]], P1[c[1]], P1[c[2]]) : Orientation3(P1[c[0]], P1[c[1]], P1[c[2]], P1[c[3]]);
+      ASSERT_EQ(sign, 1) << "element " << e;
+      measure += ElementMeasure(P1, c, out.VerticesPerCell());
+    }
+    const double box = (g.Dims[0] - 1.0) * (g.Dims[1] - 1.0) * (dim == 2 ? 1.0 : g.Dims[2] - 1.0);
+    EXPECT_NEAR(measure, box, 1e-9 * box);
+    ElementRasterizer raster(out);
+    std::vector<int> owners(g.Size(), 0);
+    for (std::int64_t e = 0; e < raster.NumberOfElements(); ++e)
+      raster.ForEachVoxel(e, [&](std::int64_t v) { owners[v]++; });
+    for (std::int64_t v = 0; v < g.Size(); ++v)
+      ASSERT_EQ(owners[v], 1) << "voxel " << v;
+    EXPECT_GT(MinimumAngle(out), MinimumAngle(mesh)) << dim << "D";
+    // The same result split into any chunks (the threads' stand-in), and again.
+    const MeshSmoothingResult again = SmoothImageMesh(mesh, fixed, image.data(), p, Chunked);
+    EXPECT_EQ(again.Mesh.Points(), out.Points());
+    EXPECT_EQ(again.Mesh.Cells(), out.Cells());
+  }
+}
+
+TEST(MeshSmoothing, RefinementReachesTheAngleBounds)
+{
+  for (int dim : { 2, 3 })
+  {
+    ImageGeometry g;
+    g.Dims = dim == 2 ? std::array<int, 3>{ { 48, 40, 1 } } : std::array<int, 3>{ { 18, 16, 14 } };
+    std::vector<std::uint8_t> fixed;
+    const SimplexMesh mesh = JitteredMesh(g, fixed, 5);
+    std::fill(fixed.begin(), fixed.end(), 1); // nothing moves: refinement alone
+    const std::vector<float> image(g.Size(), 1.f);
+    MeshSmoothingParameters p;
+    p.SliverRemoval = false;
+    const MeshSmoothingResult r = SmoothImageMesh(mesh, fixed, image.data(), p, SerialFor());
+    ASSERT_TRUE(r.Error.empty()) << r.Error;
+    EXPECT_EQ(r.Moves, 0);
+    EXPECT_GT(r.AddedNodes, 0);
+    const double bound = dim == 2 ? p.MinAngle : p.MinDihedralAngle;
+    EXPECT_LT(MinimumAngle(mesh), bound);
+    // 3D keeps the box faces as they are (no node added on them), which can leave a few elements
+    // at a face below the bound; 2D splits the box's sides as it needs.
+    if (dim == 2)
+      EXPECT_GE(MinimumAngle(r.Mesh), bound - 1e-9);
+    else
+      EXPECT_GT(MinimumAngle(r.Mesh), MinimumAngle(mesh));
+  }
+}
+
+TEST(MeshSmoothing, BadParametersAreNamed)
+{
+  MeshSmoothingParameters p;
+  EXPECT_TRUE(ValidateParameters(p).empty());
+  p.Iterations = -1;
+  EXPECT_NE(ValidateParameters(p).find("iterations"), std::string::npos);
+  p = MeshSmoothingParameters();
+  p.MinAngle = 25;
+  EXPECT_NE(ValidateParameters(p).find("minimum angle"), std::string::npos);
+  p = MeshSmoothingParameters();
+  p.Sigma = 0;
+  EXPECT_NE(ValidateParameters(p).find("sigma"), std::string::npos);
+  p = MeshSmoothingParameters();
+  p.FixedNodeSlack = -1;
+  EXPECT_NE(ValidateParameters(p).find("slack"), std::string::npos);
 }

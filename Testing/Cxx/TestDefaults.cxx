@@ -1,6 +1,7 @@
 // Every numeric property default in the plugin's XML equals the default of the VTK filter it sets
 // (which the filters take from the Core parameter structs): one source of truth, checked.
 #include "vtkDelaunayImageMesh.h"
+#include "vtkImageMeshSmoothing.h"
 #include "vtkFeatureNodes.h"
 #include "vtkSuperVoxelCut.h"
 #include "vtkVoxelCut.h"
@@ -42,6 +43,12 @@ int main(int argc, char* argv[])
     GETTER(vtkFeatureNodes, UniformSpacing), GETTER(vtkFeatureNodes, BoundarySpacing),
     GETTER(vtkDelaunayImageMesh, Backend), GETTER(vtkDelaunayImageMesh, QualityRefinement),
     GETTER(vtkDelaunayImageMesh, RadiusEdgeRatio), GETTER(vtkDelaunayImageMesh, MinDihedralAngle),
+    GETTER(vtkImageMeshSmoothing, Method), GETTER(vtkImageMeshSmoothing, Iterations),
+    GETTER(vtkImageMeshSmoothing, Sigma), GETTER(vtkImageMeshSmoothing, FeatureWeight),
+    GETTER(vtkImageMeshSmoothing, FixedNodeSlack), GETTER(vtkImageMeshSmoothing, Flips),
+    GETTER(vtkImageMeshSmoothing, QualityRefinement), GETTER(vtkImageMeshSmoothing, MinAngle),
+    GETTER(vtkImageMeshSmoothing, MinDihedralAngle), GETTER(vtkImageMeshSmoothing, SliverRemoval),
+    GETTER(vtkImageMeshSmoothing, SliverAngle),
     GETTER(vtkSuperVoxelCut, Lambda), GETTER(vtkSuperVoxelCut, Sigma), GETTER(vtkSuperVoxelCut, Bins),
     GETTER(vtkSuperVoxelCut, ScaleByContact), GETTER(vtkSuperVoxelCut, VoxelRegionTerm),
     GETTER(vtkSuperVoxelCut, Connectivity), GETTER(vtkSuperVoxelCut, Bandwidth),
@@ -52,7 +59,7 @@ int main(int argc, char* argv[])
   };
   int failures = 0, checked = 0;
   std::set<std::string> seen;
-  for (const char* file : { "FeatureNodes.xml", "DelaunayImageMesh.xml", "SuperVoxelCut.xml" })
+  for (const char* file : { "FeatureNodes.xml", "DelaunayImageMesh.xml", "ImageMeshSmoothing.xml", "SuperVoxelCut.xml" })
   {
     vtkNew<vtkXMLDataParser> parser;
     const std::string path = std::string(argv[1]) + "/" + file;

@@ -1,10 +1,12 @@
 // Rendering regression tests: each scene runs the filters on bundled data and compares the
 // picture with a committed baseline (vtkRegressionTestImage, -V baseline -T temporary dir).
 #include "vtkDelaunayImageMesh.h"
+#include "vtkImageMeshSmoothing.h"
 #include "vtkFeatureNodes.h"
 #include "vtkSuperVoxelCut.h"
 
 #include "vtkActor.h"
+#include "vtkLookupTable.h"
 #include "vtkCamera.h"
 #include "vtkCellArray.h"
 #include "vtkDataSetMapper.h"
@@ -87,6 +89,9 @@ int main(int argc, char* argv[])
   vtkNew<vtkDelaunayImageMesh> mesh;
   mesh->SetInputConnection(0, nodes->GetOutputPort(0));
   mesh->SetInputConnection(1, reader->GetOutputPort());
+  vtkNew<vtkImageMeshSmoothing> smoothing;
+  smoothing->SetInputConnection(0, mesh->GetOutputPort());
+  smoothing->SetInputConnection(1, reader->GetOutputPort());
   vtkNew<vtkSuperVoxelCut> cut;
   cut->SetInputConnection(0, mesh->GetOutputPort());
   cut->SetInputData(1, ReadSeeds(caseDir + "seeds_object.csv"));
@@ -173,13 +178,81 @@ int main(int argc, char* argv[])
     ren->GetActiveCamera()->Elevation(-60);
     ren->GetActiveCamera()->Azimuth(20);
   }
+  else if (scene == "NucleiSmoothing" || scene == "LiverSmoothing")
+  {
+    // Before (left) and after (right) Image Mesh Smoothing: a nuclei close-up coloured by the
+    // elements' mean intensity, the liver clipped and coloured by the minimum dihedral angle.
+    win->SetSize(800, 400);
+    ren->SetViewport(0, 0, 0.5, 1);
+    vtkNew<vtkRenderer> right;
+    right->SetBackground(0.1, 0.1, 0.15);
+    right->SetViewport(0.5, 0, 1, 1);
+    right->SetActiveCamera(ren->GetActiveCamera());
+    win->AddRenderer(right);
+    vtkNew<vtkPlane> plane;
+    plane->SetOrigin(180, 150, 45);
+    plane->SetNormal(0, 0, 1);
+    vtkAlgorithm* sources[2] = { mesh, smoothing };
+    vtkRenderer* renderers[2] = { ren, right };
+    for (int side = 0; side < 2; ++side)
+    {
+      vtkNew<vtkTableBasedClipDataSet> clip;
+      clip->SetInputConnection(sources[side]->GetOutputPort());
+      clip->SetClipFunction(plane);
+      clip->InsideOutOn();
+      vtkNew<vtkDataSetMapper> mapper;
+      mapper->SetInputConnection(liver ? clip->GetOutputPort() : sources[side]->GetOutputPort());
+      mapper->SetScalarModeToUseCellFieldData();
+      mapper->SelectColorArray(liver ? "MinDihedralAngle" : "MeanIntensity");
+      // Liver: red 0 deg, through yellow, to blue at 30 deg and above; nuclei: grey levels.
+      vtkNew<vtkLookupTable> table;
+      if (liver)
+      {
+        table->SetHueRange(0.0, 0.65);
+      }
+      else
+      {
+        table->SetSaturationRange(0.0, 0.0);
+        table->SetValueRange(0.15, 1.0);
+      }
+      table->Build();
+      mapper->SetLookupTable(table);
+      mapper->UseLookupTableScalarRangeOff();
+      liver ? mapper->SetScalarRange(0, 30) : mapper->SetScalarRange(0, 120);
+      vtkNew<vtkActor> actor;
+      actor->SetMapper(mapper);
+      actor->GetProperty()->EdgeVisibilityOn();
+      actor->GetProperty()->SetEdgeColor(0.1, 0.1, 0.1);
+      renderers[side]->AddActor(actor);
+    }
+    if (liver)
+    {
+      ren->ResetCamera();
+      ren->GetActiveCamera()->Elevation(-50);
+      ren->GetActiveCamera()->Zoom(1.25);
+    }
+    else
+    {
+      // A 90-pixel close-up around a nucleus.
+      vtkCamera* camera = ren->GetActiveCamera();
+      camera->ParallelProjectionOn();
+      camera->SetFocalPoint(300, 200, 0);
+      camera->SetPosition(300, 200, 500);
+      camera->SetViewUp(0, 1, 0);
+      camera->SetParallelScale(45);
+    }
+    ren->ResetCameraClippingRange();
+  }
   else
   {
     std::cerr << "unknown scene " << scene << "\n";
     return 1;
   }
-  ren->ResetCamera();
-  if (scene.rfind("Nuclei", 0) == 0)
+  if (scene != "NucleiSmoothing" && scene != "LiverSmoothing")
+  {
+    ren->ResetCamera();
+  }
+  if (scene.rfind("Nuclei", 0) == 0 && scene != "NucleiSmoothing")
   {
     ren->GetActiveCamera()->Zoom(1.4);
   }

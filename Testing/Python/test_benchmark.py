@@ -16,7 +16,7 @@ script = os.path.join(ft.fm.ROOT, "scripts", "benchmark.py")
 run = subprocess.run([shutil.which("pvpython"), script, "--runs", "1", "--out", out], env=env, capture_output=True, text=True)
 print(run.stdout[-3000:])
 ft.check(run.returncode == 0, "benchmark.py exits 0 (stderr: %s)" % run.stderr[-500:])
-ft.check("## The mesh as super-pixels" in run.stdout and "dice_random_walker" in run.stdout and "dice_watershed" in run.stdout,
+ft.check("## Mesh quality" in run.stdout and "## The mesh as super-pixels" in run.stdout and "dice_random_walker" in run.stdout and "dice_watershed" in run.stdout,
          "the printed tables hold the super-pixel table and the peer columns")
 rows = list(csv.DictReader(open(out + ".csv"))) if os.path.isfile(out + ".csv") else []
 ft.check(sorted(r["case"] for r in rows) == ["liver-ct-totalseg", "nuclei-dsb2018"], "both bundled cases in the CSV")
@@ -32,4 +32,6 @@ for r in rows:
     ft.check(low is not None and high is not None and low <= v["K"] <= high,
              "%s: SLIC runs bracket K (%s)" % (r["case"], r["slic_bracket"]))
     ft.check(v["components"] >= 1, "%s: object components reported" % r["case"])
+    ft.check(v["min_angle_smoothed"] > v["min_angle_delaunay"] and v["smoothing_s"] > 0,
+             "%s: the pipeline smooths the mesh: min angle %.2f -> %.2f" % (r["case"], v["min_angle_delaunay"], v["min_angle_smoothed"]))
 print("all benchmark checks passed")

@@ -49,36 +49,8 @@ for case, backends in (("nuclei-dsb2018", [0]), ("liver-ct-totalseg", [0, 1])):
         quality = "MinAngle" if dims[2] == 1 else "MinDihedralAngle"
         for name in ("MeanIntensity", "IntensityStdDev", "Interpolated", quality, "RadiusRatio"):
             ft.check(ug.GetCellData().GetArray(name) is not None, "%s: cell array %s" % (tag, name))
-        # Brute-force means on elements whose voxel centres all lie strictly inside (no ties).
         mean = ft.array(ug, "MeanIntensity", cells=True)
-        checked = 0
-        for e in rng.choice(len(C), 400, replace=False):
-            X = P[C[e]] / sp
-            lo, hi = np.ceil(X.min(0) - 1e-9).astype(int), np.floor(X.max(0) + 1e-9).astype(int)
-            grid = np.stack(np.meshgrid(*[np.arange(lo[a], hi[a] + 1) for a in range(3)], indexing="ij"), -1).reshape(-1, 3)
-            k = 2 if dims[2] == 1 else 3
-            T = (X[1:, :k] - X[0, :k]).T
-            bary = np.linalg.solve(T, (grid[:, :k] - X[0, :k]).T).T
-            bary = np.column_stack([1 - bary.sum(1), bary])
-            inside = (bary > 1e-9).all(1)
-            touching = (bary > -1e-9).all(1) & ~inside
-            # The filter's tie rule: a centre on the element's boundary belongs to it when a tiny
-            # step towards the box centre moves it inside.
-            centre = (np.array(dims) - 1) / 2.0
-            q = grid[touching] + 1e-6 * (centre - grid[touching])
-            bq = np.linalg.solve(T, (q[:, :k] - X[0, :k]).T).T
-            bq = np.column_stack([1 - bq.sum(1), bq])
-            if (np.abs(bq) < 1e-10).any():
-                continue
-            owned = inside.copy()
-            owned[np.flatnonzero(touching)] = (bq > 0).all(1)
-            if not owned.any():
-                continue
-            g = grid[owned]
-            brute = values[g[:, 2], g[:, 1], g[:, 0]].mean()
-            assert abs(brute - mean[e]) <= 1e-9 * max(1.0, abs(brute)), (e, brute, mean[e])
-            assert pc[e] == owned.sum(), (e, pc[e], owned.sum())
-            checked += 1
+        checked = ft.brute_force_statistics(P, C, values, dims, sp, pc, mean, rng.choice(len(C), 400, replace=False))
         ft.check(checked >= 50, "%s: MeanIntensity and PixelCount match brute force on %d sampled elements" % (tag, checked))
         # Empty circumcircle / circumsphere on a sample (points on the sphere are allowed: lattice ties).
         bad = 0

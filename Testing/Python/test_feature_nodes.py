@@ -53,7 +53,11 @@ for case, (max_fraction, min_ratio) in CASES.items():
         ft.check(pd.GetPointData().GetArray(name) is not None, "%s: point array %s" % (case, name))
     fixed = ft.array(pd, "Fixed")
     types = ft.array(pd, "NodeType")
-    ft.check(((fixed == 1) == ((types == 0) | (types == 3))).all(), "%s: Canny and boundary nodes are fixed, others free" % case)
+    dims = np.array(dims)
+    corner = ((idx == 0) | (idx == dims - 1))[:, :(3 if dims[2] > 1 else 2)].all(axis=1)
+    ft.check(((fixed == 1) == ((types == 0) | ((types == 3) & corner))).all(),
+             "%s: Canny nodes and box corners are fixed, others (other boundary nodes too) free" % case)
+    ft.check(corner.sum() == (8 if dims[2] > 1 else 4), "%s: the box corners are nodes" % case)
     ft.check(ft.array(edges).shape[0] == n_vox, "%s: edge map on the image grid" % case)
     _, _, again, _ = nodes_of(case)
     ft.check(ft.digest(P, types) == ft.digest(ft.v2n(again.GetPoints().GetData()), ft.array(again, "NodeType")), "%s: identical across two runs" % case)

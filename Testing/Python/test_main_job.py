@@ -1,5 +1,6 @@
 """The main job's script on the bundled nuclei case with cut options: it writes every file, and its
-report gives the options used, Dice, and object components whose areas sum to the label image's."""
+report gives the options used, Dice, object components whose areas sum to the label image's, and the
+mesh quality before and after smoothing (stage 3 runs by default)."""
 import json
 import os
 import shutil
@@ -29,4 +30,10 @@ ft.check(1 <= report.get("object_components", 0) <= 5 and len(volumes) == report
          "seeded object: between 1 and 5 components (5 object seeds), got %s" % report.get("object_components"))
 ft.check(abs(sum(volumes) - labels.sum()) < 1e-6, "component areas sum to the label image's object area")
 ft.check(0.0 < report.get("dice", 0) <= 1.0, "Dice reported")
+angles = report.get("angles_degrees", {})
+ft.check(report.get("smoothing") is True and "image_mesh_smoothing" in report.get("seconds", {}),
+         "stages 1 -> 2 -> 3 -> 4 ran (smoothing timed)")
+ft.check(angles.get("final", {}).get("min", 0) > angles.get("delaunay", {}).get("min", 90),
+         "quality before / after in the report: min angle %s -> %s" % (angles.get("delaunay", {}).get("min"), angles.get("final", {}).get("min")))
+ft.check("mesh quality" in run.stdout and "smoothed min" in run.stdout, "the script prints quality before / after")
 print("all main-job checks passed")

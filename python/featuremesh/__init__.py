@@ -44,7 +44,7 @@ def load_plugin(path=None, ns=None):
         ps.LoadPlugin(path or find_plugin(), ns=None)
         _loaded.append(True)
     if ns is not None:
-        for name in ("FeatureNodes", "DelaunayImageMesh", "SuperVoxelCut", "VoxelCut"):
+        for name in ("FeatureNodes", "DelaunayImageMesh", "ImageMeshSmoothing", "SuperVoxelCut", "VoxelCut"):
             ns[name] = getattr(ps, name)
 
 
@@ -107,6 +107,9 @@ class Case:
 
     def mesh(self, nodes, **properties):
         return ps.DelaunayImageMesh(Nodes=nodes, Image=self.image, Scalars=self.scalars, **properties)
+
+    def smoothing(self, mesh, **properties):
+        return ps.ImageMeshSmoothing(Mesh=mesh, Image=self.image, Scalars=self.scalars, **properties)
 
     def super_voxel_cut(self, mesh, **properties):
         return ps.SuperVoxelCut(Mesh=mesh, ObjectSeeds=self.object_seeds, BackgroundSeeds=self.background_seeds,

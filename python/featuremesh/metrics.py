@@ -201,3 +201,31 @@ def watershed_peer(unit, markers, spacing):
     gradient = ndi.gaussian_gradient_magnitude(image, 1.0)
     r = watershed(gradient, _squeeze(markers))
     return (r.reshape(unit.shape) == 1), time.perf_counter() - t, 1
+
+
+def element_angles(points, cells):
+    """Angles of every element in degrees: triangles (n, 3) -> their three angles, tetrahedra
+    (n, 4) -> their six dihedral angles; points (m, 3) in world (or frame) coordinates."""
+    P = np.asarray(points, float)[np.asarray(cells)]
+    if P.shape[1] == 3:
+        out = []
+        for k in range(3):
+            u, w = P[:, (k + 1) % 3] - P[:, k], P[:, (k + 2) % 3] - P[:, k]
+            out.append(np.degrees(np.arctan2(np.linalg.norm(np.cross(u, w), axis=1), (u * w).sum(1))))
+        return np.stack(out, axis=1)
+    # Face f is opposite vertex f; outward normals; dihedral at the edge of faces k, l = pi - angle(n_k, n_l).
+    n = []
+    for f in range(4):
+        a, b, c = P[:, (f + 1) % 4], P[:, (f + 2) % 4], P[:, (f + 3) % 4]
+        nf = np.cross(b - a, c - a)
+        nf *= -np.sign((nf * (P[:, f] - a)).sum(1))[:, None]
+        n.append(nf / np.linalg.norm(nf, axis=1)[:, None])
+    out = [np.degrees(np.arccos(np.clip(-(n[k] * n[l]).sum(1), -1, 1))) for k in range(4) for l in range(k + 1, 4)]
+    return np.stack(out, axis=1)
+
+
+def mesh_quality(points, cells):
+    """min, 1st percentile of the per-element minimum, and max angle (dihedral for tetrahedra)."""
+    a = element_angles(points, cells)
+    lo = a.min(axis=1)
+    return {"min": float(lo.min()), "p1": float(np.percentile(lo, 1)), "max": float(a.max())}

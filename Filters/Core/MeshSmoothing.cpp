@@ -1,0 +1,775 @@
+#include "MeshSmoothing.h"
+
+#include "DelaunayMesh.h"
+#include "ElementRasterizer.h"
+#include "ExactPredicates.h"
+#include "ImageFilters.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <utility>
+
+namespace featuremesh
+{
+namespace
+{
+using V3 = std::array<double, 3>;
+
+// Moved positions are multiples of 1 / Lattice voxel in index space.
+constexpr double Lattice = 1024.0;
+// A move is tried at these fractions of the step to its target, then rejected.
+constexpr double StepFractions[] = { 1.0, 0.5, 0.25 };
+
+V3 Sub(const V3& a, const V3& b)
+{
+  return { { a[0] - b[0], a[1] - b[1], a[2] - b[2] } };
+}
+V3 Cross(const V3& a, const V3& b)
+{
+  return { { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] } };
+}
+double Dot(const V3& a, const V3& b)
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+// Circumcentre of a triangle (xy) or tetrahedron in frame coordinates; false for a flat element.
+bool Circumcentre(const V3* const* v, int vpc, V3& centre)
+{
+  if (vpc == 3)
+  {
+    const V3 b = Sub(*v[1], *v[0]), c = Sub(*v[2], *v[0]);
+    const double d = 2.0 * (b[0] * c[1] - b[1] * c[0]);
+    if (d == 0.0)
+    {
+      return false;
+    }
+    const double bb = b[0] * b[0] + b[1] * b[1], cc = c[0] * c[0] + c[1] * c[1];
+    centre = { { (*v[0])[0] + (c[1] * bb - b[1] * cc) / d, (*v[0])[1] + (b[0] * cc - c[0] * bb) / d, 0.0 } };
+    return true;
+  }
+  const V3 a = Sub(*v[1], *v[0]), b = Sub(*v[2], *v[0]), c = Sub(*v[3], *v[0]);
+  const double det = 2.0 * Dot(a, Cross(b, c));
+  if (det == 0.0)
+  {
+    return false;
+  }
+  const V3 x1 = Cross(b, c), x2 = Cross(c, a), x3 = Cross(a, b);
+  const double la = Dot(a, a), lb = Dot(b, b), lc = Dot(c, c);
+  for (int k = 0; k < 3; ++k)
+  {
+    centre[k] = (*v[0])[k] + (la * x1[k] + lb * x2[k] + lc * x3[k]) / det;
+  }
+  return true;
+}
+
+double Measure(const V3* const* v, int vpc)
+{
+  if (vpc == 3)
+  {
+    const V3 b = Sub(*v[1], *v[0]), c = Sub(*v[2], *v[0]);
+    return 0.5 * std::fabs(b[0] * c[1] - b[1] * c[0]);
+  }
+  return std::fabs(Dot(Sub(*v[1], *v[0]), Cross(Sub(*v[2], *v[0]), Sub(*v[3], *v[0])))) / 6.0;
+}
+
+// A cheap stand-in for the smallest (dihedral) angle, monotone in it: minus the largest cosine of
+// the element's angles (triangle) or dihedral angles (tetrahedron). Frame coordinates.
+double AngleScore(const V3* const* v, int vpc)
+{
+  double largest = -1.0;
+  if (vpc == 3)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      const V3 u = Sub(*v[(k + 1) % 3], *v[k]), w = Sub(*v[(k + 2) % 3], *v[k]);
+      largest = std::max(largest, (u[0] * w[0] + u[1] * w[1]) / std::sqrt((u[0] * u[0] + u[1] * u[1]) * (w[0] * w[0] + w[1] * w[1])));
+    }
+    return -largest;
+  }
+  V3 n[4];
+  double length[4];
+  for (int f = 0; f < 4; ++f)
+  {
+    n[f] = Cross(Sub(*v[(f + 2) % 4], *v[(f + 1) % 4]), Sub(*v[(f + 3) % 4], *v[(f + 1) % 4]));
+    length[f] = std::sqrt(Dot(n[f], n[f]));
+    if (Dot(n[f], Sub(*v[f], *v[(f + 1) % 4])) > 0)
+    {
+      length[f] = -length[f];
+    }
+  }
+  for (int k = 0; k < 4; ++k)
+  {
+    for (int l = k + 1; l < 4; ++l)
+    {
+      largest = std::max(largest, -Dot(n[k], n[l]) / (length[k] * length[l]));
+    }
+  }
+  return -largest;
+}
+
+int ExactOrientation(const V3* const* v, int vpc)
+{
+  return vpc == 3 ? Orientation2(*v[0], *v[1], *v[2]) : Orientation3(*v[0], *v[1], *v[2], *v[3]);
+}
+
+// The working state of a smoothing run: positions in index space, the current elements and the
+// stars of their vertices.
+class Smoother
+{
+public:
+  Smoother(const SimplexMesh& mesh, const std::vector<std::uint8_t>& freeAxes)
+    : Topology(mesh)
+    , Points(mesh.Points())
+    , Anchor(mesh.Points())
+    , Free(freeAxes)
+    , Vpc(mesh.VerticesPerCell())
+  {
+  }
+
+  // The worst AngleScore over the elements of a star, in frame coordinates, with vertex `moved` at
+  // `at` (index space); -2 when an element is not positively oriented (exactly, in index space).
+  double StarQuality(const std::int64_t* star, std::int64_t n, std::int64_t moved, const V3& at) const
+  {
+    const ImageGeometry& g = this->Topology.Geometry();
+    double q = 1.0;
+    for (std::int64_t s = 0; s < n; ++s)
+    {
+      const std::int64_t* cell = this->Topology.Cell(star[s]);
+      const V3* v[4];
+      V3 frame[4];
+      for (int k = 0; k < this->Vpc; ++k)
+      {
+        v[k] = cell[k] == moved ? &at : &this->Points[cell[k]];
+      }
+      if (ExactOrientation(v, this->Vpc) <= 0)
+      {
+        return -2.0;
+      }
+      const V3* f[4];
+      for (int k = 0; k < this->Vpc; ++k)
+      {
+        frame[k] = g.IndexToFrame(*v[k]);
+        f[k] = &frame[k];
+      }
+      q = std::min(q, AngleScore(f, this->Vpc));
+    }
+    return q;
+  }
+
+  // Rounds to the lattice and into the box, keeping locked axes where they were; a fixed node with
+  // slack stays within Slack (frame units) of its anchor, in the plane normal to its edge normal.
+  V3 Constrain(std::int64_t vertex, const V3& wanted) const
+  {
+    const ImageGeometry& g = this->Topology.Geometry();
+    V3 target = wanted;
+    if (!this->Normal.empty() && this->Normal[vertex] != V3{ { 0, 0, 0 } })
+    {
+      const V3 a = g.IndexToFrame(this->Anchor[vertex]);
+      const V3 t = g.IndexToFrame(wanted);
+      V3 d = Sub(t, a);
+      const V3& n = this->Normal[vertex];
+      const double along = Dot(d, n);
+      for (int k = 0; k < 3; ++k)
+      {
+        d[k] -= along * n[k];
+      }
+      const double length = std::sqrt(Dot(d, d));
+      const double scale = length > this->Slack ? this->Slack / length : 1.0;
+      target = g.FrameToIndex({ { a[0] + scale * d[0], a[1] + scale * d[1], a[2] + scale * d[2] } });
+    }
+    V3 p = this->Points[vertex];
+    for (int a = 0; a < 3; ++a)
+    {
+      if (this->Free[vertex] & (1 << a))
+      {
+        p[a] = std::min(std::max(std::round(target[a] * Lattice) / Lattice, 0.0), g.Dims[a] - 1.0);
+      }
+    }
+    return p;
+  }
+
+  // Tries to move `vertex` towards `target` (index space): the first of the step fractions whose
+  // star stays positively oriented and at least as good as before. True when it moved.
+  bool TryMove(std::int64_t vertex, const V3& target, const std::int64_t* star, std::int64_t n)
+  {
+    const V3 from = this->Points[vertex];
+    const double before = this->StarQuality(star, n, -1, from);
+    for (const double t : StepFractions)
+    {
+      const V3 to = this->Constrain(vertex,
+        { { from[0] + t * (target[0] - from[0]), from[1] + t * (target[1] - from[1]), from[2] + t * (target[2] - from[2]) } });
+      if (to == from)
+      {
+        return false;
+      }
+      const double after = this->StarQuality(star, n, vertex, to);
+      if (after > -2.0 && after >= before)
+      {
+        this->Points[vertex] = to;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  SimplexMesh Topology;
+  std::vector<V3> Points;
+  // Where the nodes started; for fixed nodes with slack, their edge normal (unit, frame
+  // coordinates; zero for every other node) and the slack radius (frame units).
+  std::vector<V3> Anchor;
+  std::vector<V3> Normal;
+  double Slack = 0.0;
+  std::vector<std::uint8_t> Free;
+  int Vpc;
+};
+
+// Lawson flips to the Delaunay triangulation (frame coordinates, exact in-circle test): the
+// Delaunay triangulation maximises the smallest angle over all triangulations of the nodes, the
+// quantity this stage raises. Hull edges (the box) never flip. Returns the number of flips.
+std::int64_t DelaunayFlips(const SimplexMesh& mesh, const std::vector<V3>& indexPoints, std::vector<std::int64_t>& cells)
+{
+  const ImageGeometry& g = mesh.Geometry();
+  std::vector<V3> P(indexPoints.size());
+  std::transform(indexPoints.begin(), indexPoints.end(), P.begin(), [&](const V3& p) { return g.IndexToFrame(p); });
+  const std::int64_t m = static_cast<std::int64_t>(cells.size() / 3);
+  // nb[3t + k]: the triangle across the edge opposite local vertex k of t, -1 on the hull.
+  std::vector<std::int64_t> nb(3 * m, -1);
+  const SimplexMesh current(g, indexPoints, cells, 3);
+  const FaceAdjacency& faces = current.Faces();
+  for (size_t i = 0; i < faces.A.size(); ++i)
+  {
+    nb[3 * faces.A[i] + faces.LocalA[i]] = faces.B[i];
+    nb[3 * faces.B[i] + faces.LocalB[i]] = faces.A[i];
+  }
+  auto local = [&](std::int64_t t, std::int64_t v) {
+    return cells[3 * t] == v ? 0 : (cells[3 * t + 1] == v ? 1 : 2);
+  };
+  auto across = [&](std::int64_t t, std::int64_t other) {
+    return nb[3 * t] == other ? 0 : (nb[3 * t + 1] == other ? 1 : 2);
+  };
+  std::vector<std::pair<std::int64_t, int>> stack;
+  stack.reserve(3 * m);
+  for (std::int64_t t = m - 1; t >= 0; --t)
+  {
+    for (int k = 2; k >= 0; --k)
+    {
+      if (nb[3 * t + k] > t)
+      {
+        stack.emplace_back(t, k);
+      }
+    }
+  }
+  std::int64_t flips = 0;
+  while (!stack.empty())
+  {
+    const auto [t, k] = stack.back();
+    stack.pop_back();
+    const std::int64_t u = nb[3 * t + k];
+    if (u < 0)
+    {
+      continue;
+    }
+    const std::int64_t a = cells[3 * t + k], p = cells[3 * t + (k + 1) % 3], q = cells[3 * t + (k + 2) % 3];
+    const int m2 = across(u, t);
+    const std::int64_t d = cells[3 * u + m2];
+    if (InCircle(P[a], P[p], P[q], P[d]) <= 0 || Orientation2(P[a], P[p], P[d]) <= 0 ||
+      Orientation2(P[a], P[d], P[q]) <= 0)
+    {
+      continue;
+    }
+    // Outer neighbours: of t across (a, p) and (q, a); of u across (p, d) and (d, q).
+    const std::int64_t tAP = nb[3 * t + (k + 2) % 3], tQA = nb[3 * t + (k + 1) % 3];
+    const std::int64_t uPD = nb[3 * u + local(u, q)], uDQ = nb[3 * u + local(u, p)];
+    // t becomes (a, p, d), u becomes (a, d, q).
+    cells[3 * t] = a, cells[3 * t + 1] = p, cells[3 * t + 2] = d;
+    cells[3 * u] = a, cells[3 * u + 1] = d, cells[3 * u + 2] = q;
+    nb[3 * t] = uPD, nb[3 * t + 1] = u, nb[3 * t + 2] = tAP;
+    nb[3 * u] = uDQ, nb[3 * u + 1] = tQA, nb[3 * u + 2] = t;
+    if (uPD >= 0)
+    {
+      nb[3 * uPD + across(uPD, u)] = t;
+    }
+    if (tQA >= 0)
+    {
+      nb[3 * tQA + across(tQA, t)] = u;
+    }
+    ++flips;
+    // The four outer edges may have become non-Delaunay.
+    stack.emplace_back(t, 0);
+    stack.emplace_back(t, 2);
+    stack.emplace_back(u, 0);
+    stack.emplace_back(u, 1);
+  }
+  return flips;
+}
+
+// Raises the minimum dihedral angle of slivers, keeping the topology: each free vertex of a
+// tetrahedron whose minimum dihedral angle is below `sliverAngle` tries steps along the normals of
+// its slivers' opposite faces (the directions that open a flat tetrahedron) and along the axes,
+// of 1/4, 1/8 and 1/16 of its shortest edge, and takes the one that most improves its star's worst
+// element. Vertices in id order, passes until none moves. Returns the moves made.
+std::int64_t PerturbSlivers(Smoother& s, double sliverAngle, int passes, const ProgressFunction& progress, bool& aborted)
+{
+  const ImageGeometry& g = s.Topology.Geometry();
+  const std::int64_t m = s.Topology.NumberOfElements();
+  const std::int64_t nPts = static_cast<std::int64_t>(s.Points.size());
+  const CompressedRows& stars = s.Topology.Stars();
+  const double threshold = -std::cos(sliverAngle * 3.14159265358979323846 / 180.0);
+  auto frameOf = [&](std::int64_t e, V3* frame, const V3** v) {
+    const std::int64_t* cell = s.Topology.Cell(e);
+    for (int k = 0; k < 4; ++k)
+    {
+      frame[k] = g.IndexToFrame(s.Points[cell[k]]);
+      v[k] = &frame[k];
+    }
+  };
+  std::int64_t moved = 0;
+  for (int pass = 0; pass < passes; ++pass)
+  {
+    // Free vertices of slivers, in id order.
+    std::vector<std::uint8_t> candidate(nPts, 0);
+    for (std::int64_t e = 0; e < m; ++e)
+    {
+      V3 frame[4];
+      const V3* v[4];
+      frameOf(e, frame, v);
+      if (AngleScore(v, 4) < threshold)
+      {
+        for (int k = 0; k < 4; ++k)
+        {
+          candidate[s.Topology.Cell(e)[k]] = 1;
+        }
+      }
+    }
+    std::int64_t movedThisPass = 0;
+    for (std::int64_t vertex = 0; vertex < nPts; ++vertex)
+    {
+      if ((vertex & 4095) == 0 && !progress((pass + static_cast<double>(vertex) / nPts) / passes))
+      {
+        aborted = true;
+        return moved;
+      }
+      if (!candidate[vertex] || !s.Free[vertex])
+      {
+        continue;
+      }
+      const std::int64_t* star = stars.Begin(vertex);
+      const std::int64_t size = stars.Size(vertex);
+      const V3 from = s.Points[vertex];
+      const V3 at = g.IndexToFrame(from);
+      // Directions (frame coordinates): the slivers' opposite-face normals, then the axes.
+      std::vector<V3> directions;
+      double shortest = 1e300;
+      for (std::int64_t k = 0; k < size; ++k)
+      {
+        V3 frame[4];
+        const V3* v[4];
+        frameOf(star[k], frame, v);
+        const std::int64_t* cell = s.Topology.Cell(star[k]);
+        for (int l = 0; l < 4; ++l)
+        {
+          if (cell[l] != vertex)
+          {
+            const V3 d = Sub(frame[l], at);
+            shortest = std::min(shortest, std::sqrt(Dot(d, d)));
+          }
+        }
+        if (AngleScore(v, 4) >= threshold)
+        {
+          continue;
+        }
+        const int self = cell[0] == vertex ? 0 : (cell[1] == vertex ? 1 : (cell[2] == vertex ? 2 : 3));
+        V3 n = Cross(Sub(frame[(self + 2) % 4], frame[(self + 1) % 4]), Sub(frame[(self + 3) % 4], frame[(self + 1) % 4]));
+        if (Dot(n, Sub(at, frame[(self + 1) % 4])) < 0)
+        {
+          n = { { -n[0], -n[1], -n[2] } };
+        }
+        const double length = std::sqrt(Dot(n, n));
+        if (length > 0.0)
+        {
+          directions.push_back({ { n[0] / length, n[1] / length, n[2] / length } });
+        }
+      }
+      for (int a = 0; a < 3; ++a)
+      {
+        for (const double sign : { 1.0, -1.0 })
+        {
+          V3 d = { { 0, 0, 0 } };
+          d[a] = sign;
+          directions.push_back(d);
+        }
+      }
+      double best = s.StarQuality(star, size, -1, from);
+      V3 bestAt = from;
+      for (const double fraction : { 0.25, 0.125, 0.0625 })
+      {
+        for (const V3& d : directions)
+        {
+          V3 to = from;
+          for (int a = 0; a < 3; ++a)
+          {
+            to[a] += fraction * shortest * d[a] / std::fabs(g.Spacing[a]);
+          }
+          to = s.Constrain(vertex, to);
+          if (to == from)
+          {
+            continue;
+          }
+          const double q = s.StarQuality(star, size, vertex, to);
+          if (q > best)
+          {
+            best = q;
+            bestAt = to;
+          }
+        }
+      }
+      if (bestAt != from)
+      {
+        s.Points[vertex] = bestAt;
+        ++movedThisPass;
+      }
+    }
+    moved += movedThisPass;
+    if (!movedThisPass)
+    {
+      break;
+    }
+  }
+  return moved;
+}
+} // namespace
+
+std::string ValidateParameters(const MeshSmoothingParameters& p)
+{
+  if (p.Iterations < 0 || p.Iterations > 100)
+  {
+    return "the number of iterations must be in [0, 100].";
+  }
+  if (!(p.Sigma > 0.0 && p.Sigma <= 20.0))
+  {
+    return "the smoothing sigma must be in (0, 20] voxels.";
+  }
+  if (!(p.FeatureWeight >= 0.0 && p.FeatureWeight <= 1e6))
+  {
+    return "the feature weight must be in [0, 1e6].";
+  }
+  if (!(p.FixedNodeSlack >= 0.0 && p.FixedNodeSlack <= 2.0))
+  {
+    return "the fixed-node slack must be in [0, 2] voxels.";
+  }
+  if (!(p.MinAngle >= 0.0 && p.MinAngle <= 20.7))
+  {
+    return "the refinement's minimum angle must be in [0, 20.7] degrees (beyond it refinement may not end).";
+  }
+  if (!(p.MinDihedralAngle >= 0.0 && p.MinDihedralAngle < 30.0))
+  {
+    return "the refinement's minimum dihedral angle must be in [0, 30) degrees.";
+  }
+  if (!(p.SliverAngle >= 0.0 && p.SliverAngle <= 30.0))
+  {
+    return "the sliver angle must be in [0, 30] degrees.";
+  }
+  return std::string();
+}
+
+std::vector<std::uint8_t> FreeAxes(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, bool fixedMayMove)
+{
+  const ImageGeometry& g = mesh.Geometry();
+  const int dimension = g.Dimension();
+  const auto& P = mesh.Points();
+  std::vector<std::uint8_t> free(P.size(), 0);
+  for (size_t i = 0; i < P.size(); ++i)
+  {
+    if (i < fixed.size() && fixed[i] && !fixedMayMove)
+    {
+      continue;
+    }
+    for (int a = 0; a < dimension; ++a)
+    {
+      if (P[i][a] != 0.0 && P[i][a] != g.Dims[a] - 1.0)
+      {
+        free[i] |= static_cast<std::uint8_t>(1 << a);
+      }
+    }
+  }
+  return free;
+}
+
+double ElementDensity(const SimplexMesh& mesh, const std::vector<V3>& points, std::int64_t element, const float* gradient,
+  double meanGradient, double featureWeight)
+{
+  if (!(meanGradient > 0.0) || featureWeight == 0.0)
+  {
+    return 1.0;
+  }
+  const int vpc = mesh.VerticesPerCell();
+  const std::int64_t* cell = mesh.Cell(element);
+  double centroid[3] = { 0, 0, 0 };
+  for (int k = 0; k < vpc; ++k)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      centroid[a] += points[cell[k]][a] / vpc;
+    }
+  }
+  // The centroid, then the centroid of the sub-simplex joining it to face f (opposite vertex f):
+  // (centroid + sum of the face's vertices) / vpc.
+  double g = InterpolateAt(gradient, mesh.Geometry(), centroid);
+  for (int f = 0; f < vpc; ++f)
+  {
+    double sample[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      double sum = centroid[a];
+      for (int k = 0; k < vpc; ++k)
+      {
+        sum += k == f ? 0.0 : points[cell[k]][a];
+      }
+      sample[a] = sum / vpc;
+    }
+    g += InterpolateAt(gradient, mesh.Geometry(), sample);
+  }
+  return 1.0 + featureWeight * (g / (vpc + 1)) / meanGradient;
+}
+
+V3 SmoothingTarget(const SimplexMesh& mesh, const std::vector<V3>& points, const std::int64_t* star,
+  std::int64_t starSize, const double* density, SmoothingMethod method)
+{
+  const ImageGeometry& g = mesh.Geometry();
+  const int vpc = mesh.VerticesPerCell();
+  const V3 boxHigh = g.IndexToFrame({ { g.Dims[0] - 1.0, g.Dims[1] - 1.0, g.Dims[2] - 1.0 } });
+  double weightSum = 0.0;
+  V3 sum = { { 0, 0, 0 } };
+  for (std::int64_t s = 0; s < starSize; ++s)
+  {
+    const std::int64_t* cell = mesh.Cell(star[s]);
+    V3 frame[4];
+    const V3* v[4];
+    for (int k = 0; k < vpc; ++k)
+    {
+      frame[k] = g.IndexToFrame(points[cell[k]]);
+      v[k] = &frame[k];
+    }
+    V3 centre = { { 0, 0, 0 } };
+    if (method == SmoothingMethod::ODT && Circumcentre(v, vpc, centre))
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        centre[a] = std::min(std::max(centre[a], 0.0), boxHigh[a]);
+      }
+    }
+    else
+    {
+      for (int k = 0; k < vpc; ++k)
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          centre[a] += frame[k][a] / vpc;
+        }
+      }
+    }
+    const double w = density[s] * Measure(v, vpc);
+    weightSum += w;
+    for (int a = 0; a < 3; ++a)
+    {
+      sum[a] += w * centre[a];
+    }
+  }
+  if (!(weightSum > 0.0))
+  {
+    return { { std::nan(""), std::nan(""), std::nan("") } };
+  }
+  return g.FrameToIndex({ { sum[0] / weightSum, sum[1] / weightSum, sum[2] / weightSum } });
+}
+
+MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, const float* values,
+  const MeshSmoothingParameters& p, const ParallelFor& parallel, const ProgressFunction& progress)
+{
+  MeshSmoothingResult result;
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+  auto t0 = Clock::now();
+  const ImageGeometry& g = mesh.Geometry();
+  const int vpc = mesh.VerticesPerCell();
+  const std::int64_t n = mesh.NumberOfPoints();
+  // The smoothed image: its gradient magnitude weighs the density, its gradient direction is the
+  // normal along which fixed nodes may not slide.
+  const bool slide = p.FixedNodeSlack > 0.0;
+  std::vector<float> smoothed, gradient;
+  double meanGradient = 0.0;
+  if ((p.FeatureWeight != 0.0 || slide) && p.Iterations > 0)
+  {
+    smoothed.resize(static_cast<size_t>(g.Size()));
+    GaussianSmooth(values, smoothed.data(), g, p.Sigma, parallel);
+  }
+  if (p.FeatureWeight != 0.0 && p.Iterations > 0)
+  {
+    gradient.resize(smoothed.size());
+    GradientMagnitude(smoothed.data(), g, gradient.data(), parallel);
+    meanGradient = std::accumulate(gradient.begin(), gradient.end(), 0.0) / static_cast<double>(gradient.size());
+  }
+  const std::vector<std::uint8_t> freeAxes = FreeAxes(mesh, fixed, slide);
+  Smoother s(mesh, freeAxes);
+  if (slide && !smoothed.empty())
+  {
+    s.Slack = p.FixedNodeSlack * std::min(std::fabs(g.Spacing[0]), std::fabs(g.Spacing[1]));
+    s.Normal.assign(n, V3{ { 0, 0, 0 } });
+    for (std::int64_t v = 0; v < n; ++v)
+    {
+      if (v >= static_cast<std::int64_t>(fixed.size()) || !fixed[v] || !freeAxes[v])
+      {
+        continue;
+      }
+      // Central differences of the smoothed image at the node, per frame unit.
+      V3 normal = { { 0, 0, 0 } };
+      for (int a = 0; a < vpc - 1; ++a)
+      {
+        double lo[3] = { s.Anchor[v][0], s.Anchor[v][1], s.Anchor[v][2] }, hi[3] = { lo[0], lo[1], lo[2] };
+        lo[a] -= 0.5;
+        hi[a] += 0.5;
+        normal[a] = (InterpolateAt(smoothed.data(), g, hi) - InterpolateAt(smoothed.data(), g, lo)) / std::fabs(g.Spacing[a]);
+      }
+      const double length = std::sqrt(Dot(normal, normal));
+      if (length > 0.0)
+      {
+        s.Normal[v] = { { normal[0] / length, normal[1] / length, normal[2] / length } };
+      }
+      else
+      {
+        s.Free[v] = 0; // no edge direction: stays fixed
+      }
+    }
+  }
+  result.DensitySeconds = since(t0);
+  t0 = Clock::now();
+  const int sweeps = std::max(0, p.Iterations);
+  const bool perturb = vpc == 4 && p.SliverRemoval && sweeps > 0;
+  const double sweepShare = perturb ? 0.8 : 1.0;
+  std::vector<double> elementDensity, density;
+  for (int it = 0; it < sweeps; ++it)
+  {
+    const CompressedRows& stars = s.Topology.Stars();
+    // Densities once per sweep, from the positions at its start.
+    const std::int64_t m = s.Topology.NumberOfElements();
+    elementDensity.assign(m, 1.0);
+    if (!gradient.empty())
+    {
+      parallel(m, 8192, [&](std::int64_t b, std::int64_t e) {
+        for (std::int64_t c = b; c < e; ++c)
+        {
+          elementDensity[c] = ElementDensity(s.Topology, s.Points, c, gradient.data(), meanGradient, p.FeatureWeight);
+        }
+      });
+    }
+    for (std::int64_t v = 0; v < n; ++v)
+    {
+      if ((v & 4095) == 0 && !progress(sweepShare * (it + 0.9 * v / static_cast<double>(n)) / sweeps))
+      {
+        result.Aborted = true;
+        return result;
+      }
+      if (!s.Free[v] || stars.Size(v) == 0)
+      {
+        continue;
+      }
+      const std::int64_t* star = stars.Begin(v);
+      const std::int64_t size = stars.Size(v);
+      density.resize(size);
+      for (std::int64_t k = 0; k < size; ++k)
+      {
+        density[k] = elementDensity[star[k]];
+      }
+      const V3 target = SmoothingTarget(s.Topology, s.Points, star, size, density.data(), p.Method);
+      if (std::isfinite(target[0]) && s.TryMove(v, target, star, size))
+      {
+        ++result.Moves;
+      }
+    }
+    if (p.Flips)
+    {
+      std::vector<std::int64_t> cells = s.Topology.Cells();
+      if (vpc == 3)
+      {
+        result.Flips += DelaunayFlips(s.Topology, s.Points, cells);
+      }
+      else
+      {
+        // Re-tetrahedralise the moved nodes (CGAL; the same ids, so node arrays still apply).
+        std::vector<V3> frame(s.Points.size());
+        std::transform(s.Points.begin(), s.Points.end(), frame.begin(), [&](const V3& q) { return g.IndexToFrame(q); });
+        DelaunayOptions o;
+        o.Backend = DelaunayBackend::CGAL;
+        DelaunayResult d = Tetrahedralize(frame, o);
+        if (!d.Error.empty() || d.Points.size() != frame.size())
+        {
+          result.Error = "re-tetrahedralising the moved nodes failed: " + d.Error;
+          return result;
+        }
+        cells = std::move(d.Cells);
+      }
+      s.Topology = SimplexMesh(g, s.Points, std::move(cells), vpc);
+      // Positive orientation in frame coordinates is positive in index space (positive scales).
+    }
+    else
+    {
+      s.Topology.SetPoints(s.Points);
+    }
+    result.IterationsRun = it + 1;
+  }
+  result.SweepSeconds = since(t0);
+  t0 = Clock::now();
+  if (p.QualityRefinement && sweeps > 0)
+  {
+    std::vector<V3> frame(s.Points.size());
+    std::transform(s.Points.begin(), s.Points.end(), frame.begin(), [&](const V3& q) { return g.IndexToFrame(q); });
+    DelaunayResult d;
+    if (vpc == 3)
+    {
+      d = RefineQuality2D(frame, p.MinAngle);
+    }
+    else
+    {
+      DelaunayOptions o;
+      o.QualityRefinement = true;
+      o.MinDihedralAngle = p.MinDihedralAngle;
+      o.RadiusEdgeRatio = p.RadiusEdgeRatio;
+      o.PreserveBoundary = true;
+      d = Tetrahedralize(frame, o);
+    }
+    if (!d.Error.empty() || d.Points.size() < frame.size())
+    {
+      result.Error = "quality refinement failed: " + d.Error;
+      return result;
+    }
+    result.AddedNodes = static_cast<std::int64_t>(d.Points.size() - frame.size());
+    std::vector<V3> index = s.Points;
+    for (size_t i = frame.size(); i < d.Points.size(); ++i)
+    {
+      index.push_back(g.FrameToIndex(d.Points[i]));
+    }
+    SimplexMesh refined(g, std::move(index), std::move(d.Cells), vpc);
+    refined.OrientPositively();
+    std::vector<std::uint8_t> fixedAll(fixed);
+    fixedAll.resize(refined.NumberOfPoints(), 0);
+    Smoother r(refined, FreeAxes(refined, fixedAll));
+    s = std::move(r);
+  }
+  result.RefinementSeconds = since(t0);
+  t0 = Clock::now();
+  if (perturb)
+  {
+    result.Perturbed = PerturbSlivers(s, p.SliverAngle, 10, SubProgress(progress, sweepShare, 1.0), result.Aborted);
+    if (result.Aborted)
+    {
+      return result;
+    }
+    s.Topology.SetPoints(s.Points);
+  }
+  result.SliverSeconds = since(t0);
+  result.Mesh = std::move(s.Topology);
+  return result;
+}
+} // namespace featuremesh

@@ -1,0 +1,97 @@
+// Stage 3: image-weighted smoothing of an image mesh. Each iteration moves every free node once
+// (Gauss-Seidel, in node order) to its CVT or ODT position under a feature density, then restores
+// the Delaunay property of the moved nodes; tetrahedral meshes finish with sliver removal.
+//
+// Density (thesis 2.3): rho(T) = 1 + FeatureWeight * g(T) / mean(g), g(T) the gradient magnitude of
+// the Gaussian-smoothed image averaged over T's centroid and the centroids of the sub-simplices
+// that join it to T's faces (4 samples for a triangle, 5 for a tetrahedron). The 1 keeps flat
+// regions (g = 0, e.g. the air around a brain) meshable; mean(g) makes the weight unit-free.
+//
+// Which nodes move: Fixed nodes never; a free node on the image box's surface slides in that face
+// or edge only (box corners never move), so the mesh keeps tiling the box. A move that would
+// invert an element, or lower the smallest angle of the node's star, is halved (twice) and then
+// rejected. Moved positions are rounded to 1/1024 voxel in index space; the rasteriser's exact
+// predicates keep voxel ownership exact off the lattice.
+#pragma once
+
+#include "Parallel.h"
+#include "SimplexMesh.h"
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace featuremesh
+{
+enum class SmoothingMethod
+{
+  CVT = 0, // thesis eq. 10: density-weighted mean of the star's centroids
+  ODT = 1  // thesis eq. 12: density-weighted mean of the star's circumcentres
+};
+
+struct MeshSmoothingParameters
+{
+  SmoothingMethod Method = SmoothingMethod::ODT;
+  // Thesis 2.3: five iterations.
+  int Iterations = 5;
+  // Gaussian sigma (voxels) of the smoothing before the gradient magnitude.
+  double Sigma = 1.0;
+  // Weight of the gradient in the density; 0 gives plain (unweighted) CVT / ODT.
+  double FeatureWeight = 1.0;
+  // Fixed nodes (Canny) may slide up to this many voxels along their edge (normal to the smoothed
+  // image's gradient); 0 keeps them where they are.
+  double FixedNodeSlack = 0.0;
+  // Restore the Delaunay property after each sweep (2D: Lawson edge flips; 3D: re-tetrahedralise).
+  bool Flips = true;
+  // After the sweeps, add nodes where elements stay below the angle bounds (Delaunay refinement:
+  // 2D CGAL to MinAngle, at most 20.7 degrees; 3D TetGen to MinDihedralAngle and a radius-edge
+  // ratio of 2). Added nodes are free.
+  bool QualityRefinement = true;
+  double MinAngle = 20.0;
+  double MinDihedralAngle = 10.0;
+  double RadiusEdgeRatio = 2.0;
+  // 3D: after the last sweep, move the free vertices of tetrahedra whose minimum dihedral angle is
+  // below SliverAngle (degrees) to raise it (sliver perturbation; topology fixed).
+  bool SliverRemoval = true;
+  double SliverAngle = 15.0;
+};
+
+// Empty when the parameters are usable, else a sentence naming the bad one.
+std::string ValidateParameters(const MeshSmoothingParameters& parameters);
+
+// Per-node freedom: which index axes a node may move along (bit a = axis a): none for fixed nodes
+// (unless fixedMayMove) and box corners, the axes of its face or edge for a node on the box.
+std::vector<std::uint8_t> FreeAxes(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, bool fixedMayMove = false);
+
+// Density rho of an element of `mesh` (see above) with its vertices at `points` (index space), from
+// a gradient-magnitude image on the mesh's grid; `meanGradient` is mean(g) over the image (0: rho = 1).
+double ElementDensity(const SimplexMesh& mesh, const std::vector<std::array<double, 3>>& points, std::int64_t element,
+  const float* gradient, double meanGradient, double featureWeight);
+
+// Where CVT or ODT moves a vertex: sum over its star of rho * |T| * c_T / sum of rho * |T|, with c_T
+// the centroid (CVT) or the circumcentre clamped into the image box (ODT); measures and centres in
+// frame coordinates, the result in index space. `density` has one value per element of `star`.
+std::array<double, 3> SmoothingTarget(const SimplexMesh& mesh, const std::vector<std::array<double, 3>>& points,
+  const std::int64_t* star, std::int64_t starSize, const double* density, SmoothingMethod method);
+
+struct MeshSmoothingResult
+{
+  SimplexMesh Mesh;
+  int IterationsRun = 0;
+  std::int64_t Moves = 0;      // accepted moves over all sweeps
+  std::int64_t Flips = 0;      // 2D edge flips (3D: tetrahedra changed by re-tetrahedralising)
+  std::int64_t Perturbed = 0;  // 3D sliver-removal moves
+  std::int64_t AddedNodes = 0; // by quality refinement; they follow the input's points
+  // Seconds: density image, sweeps (with flips / re-tetrahedralisation), refinement, slivers.
+  double DensitySeconds = 0, SweepSeconds = 0, RefinementSeconds = 0, SliverSeconds = 0;
+  bool Aborted = false;
+  std::string Error;
+};
+
+// Smooths `mesh` (index space, elements positively oriented, tiling the image box) on the image
+// `values` (one per voxel). `fixed` has one flag per mesh point.
+MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, const float* values,
+  const MeshSmoothingParameters& parameters, const ParallelFor& parallel,
+  const ProgressFunction& progress = NoProgress());
+} // namespace featuremesh

@@ -1,0 +1,98 @@
+/**
+ * @class   vtkImageMeshSmoothing
+ * @brief   Image-weighted CVT / ODT smoothing of an image mesh with edge flips and sliver removal
+ *          (FeatureMesh stage 3).
+ *
+ * Input 0 "Mesh": a Delaunay Image Mesh output (triangles or tetrahedra with its cell arrays and
+ * image frame); input 1 "Image": the image it was made from. Each iteration moves every free node
+ * (Gauss-Seidel, node order) to its CVT or ODT position under a density that grows with the image
+ * gradient, then restores the Delaunay property (2D edge flips, 3D re-tetrahedralisation); 3D
+ * meshes finish with sliver perturbation. Fixed nodes (point array Fixed = 1) never move; free
+ * nodes on the image box slide in their face or edge; box corners stay. The output has the same
+ * points (moved) and point arrays, new elements, and stage 2's cell arrays recomputed exactly.
+ * See Filters/Core/MeshSmoothing.h.
+ */
+#ifndef vtkImageMeshSmoothing_h
+#define vtkImageMeshSmoothing_h
+
+#include "FeatureMeshFiltersModule.h"
+#include "vtkUnstructuredGridAlgorithm.h"
+
+class FEATUREMESHFILTERS_EXPORT vtkImageMeshSmoothing : public vtkUnstructuredGridAlgorithm
+{
+public:
+  static vtkImageMeshSmoothing* New();
+  vtkTypeMacro(vtkImageMeshSmoothing, vtkUnstructuredGridAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  enum Methods
+  {
+    CVT = 0,
+    ODT = 1
+  };
+  /// CVT (thesis eq. 10) or ODT (eq. 12, default).
+  vtkSetClampMacro(Method, int, CVT, ODT);
+  vtkGetMacro(Method, int);
+  /// Smoothing sweeps (default 5, the thesis's); 0 passes the mesh through.
+  vtkSetMacro(Iterations, int);
+  vtkGetMacro(Iterations, int);
+  /// Gaussian sigma (voxels) before the gradient magnitude of the density (default 1).
+  vtkSetMacro(Sigma, double);
+  vtkGetMacro(Sigma, double);
+  /// Weight of the image gradient in the density (default 1; 0 = unweighted CVT / ODT).
+  vtkSetMacro(FeatureWeight, double);
+  vtkGetMacro(FeatureWeight, double);
+  /// Voxels a fixed (Canny) node may slide along its edge; 0 keeps fixed nodes in place.
+  vtkSetMacro(FixedNodeSlack, double);
+  vtkGetMacro(FixedNodeSlack, double);
+  /// Restore the Delaunay property after each sweep (default on).
+  vtkSetMacro(Flips, bool);
+  vtkGetMacro(Flips, bool);
+  vtkBooleanMacro(Flips, bool);
+  /// Add nodes (Delaunay refinement) where elements stay below MinAngle (2D, default 20 degrees)
+  /// or MinDihedralAngle (3D, default 10 degrees) after the sweeps. On by default.
+  vtkSetMacro(QualityRefinement, bool);
+  vtkGetMacro(QualityRefinement, bool);
+  vtkBooleanMacro(QualityRefinement, bool);
+  vtkSetMacro(MinAngle, double);
+  vtkGetMacro(MinAngle, double);
+  vtkSetMacro(MinDihedralAngle, double);
+  vtkGetMacro(MinDihedralAngle, double);
+  /// 3D: perturb the free vertices of tetrahedra whose minimum dihedral angle is below SliverAngle.
+  vtkSetMacro(SliverRemoval, bool);
+  vtkGetMacro(SliverRemoval, bool);
+  vtkBooleanMacro(SliverRemoval, bool);
+  vtkSetMacro(SliverAngle, double);
+  vtkGetMacro(SliverAngle, double);
+
+  void SetImageConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(1, output); }
+
+protected:
+  vtkImageMeshSmoothing();
+  ~vtkImageMeshSmoothing() override = default;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  // Defaults: featuremesh::MeshSmoothingParameters.
+  int Method;
+  int Iterations;
+  double Sigma;
+  double FeatureWeight;
+  double FixedNodeSlack;
+  bool Flips;
+  bool QualityRefinement;
+  double MinAngle;
+  double MinDihedralAngle;
+  bool SliverRemoval;
+  double SliverAngle;
+
+private:
+  vtkMTimeType FailedAt = 0;
+  double FailedAtTime = 0.0;
+  vtkImageMeshSmoothing(const vtkImageMeshSmoothing&) = delete;
+  void operator=(const vtkImageMeshSmoothing&) = delete;
+};
+
+#endif
