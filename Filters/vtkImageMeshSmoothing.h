@@ -5,9 +5,10 @@
  *
  * Input 0 "Mesh": a Delaunay Image Mesh output (triangles or tetrahedra with its cell arrays and
  * image frame); input 1 "Image": the image it was made from. Each iteration moves every free node
- * (Gauss-Seidel, node order) to its CVT or ODT position under a density that grows with the image
- * gradient, then restores the Delaunay property (2D edge flips, 3D re-tetrahedralisation); 3D
- * meshes finish with sliver perturbation. Fixed nodes (point array Fixed = 1) never move; free
+ * (multicolour Gauss-Seidel) to its CVT or ODT position under a density that grows with the image
+ * gradient, then restores the Delaunay property (2D edge flips, 3D re-tetrahedralisation);
+ * Delaunay refinement then adds nodes where the angle bounds are missed (2D CGAL, 3D TetGen with
+ * the box faces kept), and 3D meshes finish with sliver perturbation. Fixed nodes (point array Fixed = 1) never move; free
  * nodes on the image box slide in their face or edge; box corners stay. The output has the same
  * points (moved) and point arrays, new elements, and stage 2's cell arrays recomputed exactly.
  * See Filters/Core/MeshSmoothing.h.

@@ -18,31 +18,29 @@ template <typename T>
 double InterpolateAt(const T* values, const ImageGeometry& g, const double index[3])
 {
   int base[3];
-  double t[3];
+  double w[3][2];
+  std::int64_t step[3];
+  const std::int64_t stride[3] = { 1, g.Dims[0], g.SliceStride() };
   for (int a = 0; a < 3; ++a)
   {
     const double c = std::min(std::max(index[a], 0.0), static_cast<double>(g.Dims[a] - 1));
     base[a] = std::min(static_cast<int>(std::floor(c)), std::max(0, g.Dims[a] - 2));
-    t[a] = g.Dims[a] > 1 ? c - base[a] : 0.0;
+    const double t = g.Dims[a] > 1 ? c - base[a] : 0.0;
+    w[a][0] = 1.0 - t;
+    // A one-voxel axis has no upper neighbour: weight 0.
+    w[a][1] = g.Dims[a] > 1 ? t : 0.0;
+    step[a] = g.Dims[a] > 1 ? stride[a] : 0;
   }
+  const T* origin = values + g.Index(base[0], base[1], base[2]);
+  // Corners in bit order (x fastest), each weight the product in axis order, zero weights skipped.
   double result = 0.0;
   for (int corner = 0; corner < 8; ++corner)
   {
-    double w = 1.0;
-    int ijk[3];
-    for (int a = 0; a < 3; ++a)
+    const int bx = corner & 1, by = (corner >> 1) & 1, bz = (corner >> 2) & 1;
+    const double weight = w[0][bx] * w[1][by] * w[2][bz];
+    if (weight != 0.0)
     {
-      const int bit = (corner >> a) & 1;
-      if (g.Dims[a] == 1 && bit)
-      {
-        w = 0.0;
-      }
-      ijk[a] = std::min(base[a] + bit, g.Dims[a] - 1);
-      w *= bit ? t[a] : 1.0 - t[a];
-    }
-    if (w != 0.0)
-    {
-      result += w * values[g.Index(ijk[0], ijk[1], ijk[2])];
+      result += weight * origin[bx * step[0] + by * step[1] + bz * step[2]];
     }
   }
   return result;

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <utility>
 
@@ -21,6 +22,8 @@ using V3 = std::array<double, 3>;
 constexpr double Lattice = 1024.0;
 // A move is tried at these fractions of the step to its target, then rejected.
 constexpr double StepFractions[] = { 1.0, 0.5, 0.25 };
+// A cached value still to compute.
+constexpr double Stale = std::numeric_limits<double>::quiet_NaN();
 
 V3 Sub(const V3& a, const V3& b)
 {
@@ -191,12 +194,29 @@ public:
     return p;
   }
 
+  // StarQuality at the current positions, through a per-element cache (Score, NaN = stale).
+  double CurrentStarQuality(const std::int64_t* star, std::int64_t n)
+  {
+    double q = 1.0;
+    for (std::int64_t s = 0; s < n; ++s)
+    {
+      double& score = this->Score[star[s]];
+      if (std::isnan(score))
+      {
+        score = this->StarQuality(star + s, 1, -1, V3{ { 0, 0, 0 } });
+      }
+      q = std::min(q, score);
+    }
+    return q;
+  }
+
   // Tries to move `vertex` towards `target` (index space): the first of the step fractions whose
-  // star stays positively oriented and at least as good as before. True when it moved.
+  // star stays positively oriented and at least as good as before. True when it moved. Touches
+  // only the vertex and its star's cached scores: vertices that share no element may move at once.
   bool TryMove(std::int64_t vertex, const V3& target, const std::int64_t* star, std::int64_t n)
   {
     const V3 from = this->Points[vertex];
-    const double before = this->StarQuality(star, n, -1, from);
+    const double before = this->CurrentStarQuality(star, n);
     for (const double t : StepFractions)
     {
       const V3 to = this->Constrain(vertex,
@@ -209,6 +229,10 @@ public:
       if (after > -2.0 && after >= before)
       {
         this->Points[vertex] = to;
+        for (std::int64_t k = 0; k < n; ++k)
+        {
+          this->Score[star[k]] = Stale;
+        }
         return true;
       }
     }
@@ -223,27 +247,38 @@ public:
   std::vector<V3> Normal;
   double Slack = 0.0;
   std::vector<std::uint8_t> Free;
+  // Cached AngleScore per element (NaN: to compute).
+  std::vector<double> Score;
   int Vpc;
 };
 
 // Lawson flips to the Delaunay triangulation (frame coordinates, exact in-circle test): the
 // Delaunay triangulation maximises the smallest angle over all triangulations of the nodes, the
 // quantity this stage raises. Hull edges (the box) never flip. Returns the number of flips.
-std::int64_t DelaunayFlips(const SimplexMesh& mesh, const std::vector<V3>& indexPoints, std::vector<std::int64_t>& cells)
+// nb[3t + k]: the triangle across the edge opposite local vertex k of t, -1 on the hull.
+std::vector<std::int64_t> TriangleNeighbours(const SimplexMesh& mesh)
 {
-  const ImageGeometry& g = mesh.Geometry();
-  std::vector<V3> P(indexPoints.size());
-  std::transform(indexPoints.begin(), indexPoints.end(), P.begin(), [&](const V3& p) { return g.IndexToFrame(p); });
-  const std::int64_t m = static_cast<std::int64_t>(cells.size() / 3);
-  // nb[3t + k]: the triangle across the edge opposite local vertex k of t, -1 on the hull.
-  std::vector<std::int64_t> nb(3 * m, -1);
-  const SimplexMesh current(g, indexPoints, cells, 3);
-  const FaceAdjacency& faces = current.Faces();
+  std::vector<std::int64_t> nb(3 * mesh.NumberOfElements(), -1);
+  const FaceAdjacency& faces = mesh.Faces();
   for (size_t i = 0; i < faces.A.size(); ++i)
   {
     nb[3 * faces.A[i] + faces.LocalA[i]] = faces.B[i];
     nb[3 * faces.B[i] + faces.LocalB[i]] = faces.A[i];
   }
+  return nb;
+}
+
+// Lawson flips to the Delaunay triangulation (frame coordinates, exact in-circle test): the
+// Delaunay triangulation maximises the smallest angle over all triangulations of the nodes, the
+// quantity this stage raises. Hull edges (the box) never flip. Only edges of triangles with a
+// moved vertex can have become non-Delaunay: they seed the flips. `nb` (TriangleNeighbours) is
+// kept up to date. Returns the number of flips.
+std::int64_t DelaunayFlips(const ImageGeometry& g, const std::vector<V3>& indexPoints, const std::vector<std::uint8_t>& moved,
+  std::vector<std::int64_t>& cells, std::vector<std::int64_t>& nb)
+{
+  std::vector<V3> P(indexPoints.size());
+  std::transform(indexPoints.begin(), indexPoints.end(), P.begin(), [&](const V3& p) { return g.IndexToFrame(p); });
+  const std::int64_t m = static_cast<std::int64_t>(cells.size() / 3);
   auto local = [&](std::int64_t t, std::int64_t v) {
     return cells[3 * t] == v ? 0 : (cells[3 * t + 1] == v ? 1 : 2);
   };
@@ -251,12 +286,15 @@ std::int64_t DelaunayFlips(const SimplexMesh& mesh, const std::vector<V3>& index
     return nb[3 * t] == other ? 0 : (nb[3 * t + 1] == other ? 1 : 2);
   };
   std::vector<std::pair<std::int64_t, int>> stack;
-  stack.reserve(3 * m);
   for (std::int64_t t = m - 1; t >= 0; --t)
   {
+    if (!moved[cells[3 * t]] && !moved[cells[3 * t + 1]] && !moved[cells[3 * t + 2]])
+    {
+      continue;
+    }
     for (int k = 2; k >= 0; --k)
     {
-      if (nb[3 * t + k] > t)
+      if (nb[3 * t + k] >= 0)
       {
         stack.emplace_back(t, k);
       }
@@ -580,7 +618,7 @@ V3 SmoothingTarget(const SimplexMesh& mesh, const std::vector<V3>& points, const
   }
   if (!(weightSum > 0.0))
   {
-    return { { std::nan(""), std::nan(""), std::nan("") } };
+    return { { Stale, Stale, Stale } };
   }
   return g.FrameToIndex({ { sum[0] / weightSum, sum[1] / weightSum, sum[2] / weightSum } });
 }
@@ -648,52 +686,109 @@ MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<s
   const int sweeps = std::max(0, p.Iterations);
   const bool perturb = vpc == 4 && p.SliverRemoval && sweeps > 0;
   const double sweepShare = perturb ? 0.8 : 1.0;
-  std::vector<double> elementDensity, density;
+  std::vector<double> elementDensity;
+  std::vector<std::int64_t> neighbours = vpc == 3 && p.Flips && sweeps > 0 ? TriangleNeighbours(mesh) : std::vector<std::int64_t>();
+  std::vector<std::uint8_t> moved(n);
   for (int it = 0; it < sweeps; ++it)
   {
     const CompressedRows& stars = s.Topology.Stars();
-    // Densities once per sweep, from the positions at its start.
-    const std::int64_t m = s.Topology.NumberOfElements();
-    elementDensity.assign(m, 1.0);
-    if (!gradient.empty())
-    {
-      parallel(m, 8192, [&](std::int64_t b, std::int64_t e) {
-        for (std::int64_t c = b; c < e; ++c)
-        {
-          elementDensity[c] = ElementDensity(s.Topology, s.Points, c, gradient.data(), meanGradient, p.FeatureWeight);
-        }
-      });
-    }
+    // An element's density is computed when a node first needs it in this sweep.
+    elementDensity.assign(s.Topology.NumberOfElements(), -1.0);
+    std::fill(moved.begin(), moved.end(), 0);
+    // Multicolour Gauss-Seidel: nodes of one colour share no element, so they move at once (any
+    // thread count gives the same result); colours greedily in node order, classes in colour order.
+    std::vector<int> colour(n, -1);
+    std::vector<int> lastSeen;
+    int colours = 0;
     for (std::int64_t v = 0; v < n; ++v)
     {
-      if ((v & 4095) == 0 && !progress(sweepShare * (it + 0.9 * v / static_cast<double>(n)) / sweeps))
-      {
-        result.Aborted = true;
-        return result;
-      }
       if (!s.Free[v] || stars.Size(v) == 0)
       {
         continue;
       }
-      const std::int64_t* star = stars.Begin(v);
-      const std::int64_t size = stars.Size(v);
-      density.resize(size);
-      for (std::int64_t k = 0; k < size; ++k)
+      // Neighbours through the star (cheaper than building the vertex-neighbour rows).
+      for (const std::int64_t* e = stars.Begin(v); e != stars.End(v); ++e)
       {
-        density[k] = elementDensity[star[k]];
+        const std::int64_t* cell = s.Topology.Cell(*e);
+        for (int k = 0; k < vpc; ++k)
+        {
+          if (colour[cell[k]] >= 0)
+          {
+            lastSeen[colour[cell[k]]] = static_cast<int>(v);
+          }
+        }
       }
-      const V3 target = SmoothingTarget(s.Topology, s.Points, star, size, density.data(), p.Method);
-      if (std::isfinite(target[0]) && s.TryMove(v, target, star, size))
+      int c = 0;
+      while (c < colours && lastSeen[c] == v)
       {
-        ++result.Moves;
+        ++c;
+      }
+      if (c == colours)
+      {
+        ++colours;
+        lastSeen.push_back(-1);
+      }
+      colour[v] = c;
+    }
+    std::vector<std::int64_t> classStart(colours + 1, 0), byColour;
+    for (std::int64_t v = 0; v < n; ++v)
+    {
+      classStart[colour[v] + 1] += colour[v] >= 0 ? 1 : 0;
+    }
+    std::partial_sum(classStart.begin(), classStart.end(), classStart.begin());
+    byColour.resize(classStart[colours]);
+    {
+      std::vector<std::int64_t> fill(classStart.begin(), classStart.end() - 1);
+      for (std::int64_t v = 0; v < n; ++v)
+      {
+        if (colour[v] >= 0)
+        {
+          byColour[fill[colour[v]]++] = v;
+        }
       }
     }
-    if (p.Flips)
+    s.Score.assign(s.Topology.NumberOfElements(), Stale);
+    for (int c = 0; c < colours; ++c)
+    {
+      if (!progress(sweepShare * (it + 0.9 * c / static_cast<double>(colours)) / sweeps))
+      {
+        result.Aborted = true;
+        return result;
+      }
+      parallel(classStart[c + 1] - classStart[c], 256, [&](std::int64_t b, std::int64_t e) {
+        std::vector<double> density;
+        for (std::int64_t i = classStart[c] + b; i < classStart[c] + e; ++i)
+        {
+          const std::int64_t v = byColour[i];
+          const std::int64_t* star = stars.Begin(v);
+          const std::int64_t size = stars.Size(v);
+          density.resize(size);
+          for (std::int64_t k = 0; k < size; ++k)
+          {
+            double& rho = elementDensity[star[k]];
+            if (rho < 0.0)
+            {
+              rho = gradient.empty() ? 1.0 : ElementDensity(s.Topology, s.Points, star[k], gradient.data(), meanGradient, p.FeatureWeight);
+            }
+            density[k] = rho;
+          }
+          const V3 target = SmoothingTarget(s.Topology, s.Points, star, size, density.data(), p.Method);
+          if (std::isfinite(target[0]) && s.TryMove(v, target, star, size))
+          {
+            moved[v] = 1;
+          }
+        }
+      });
+    }
+    result.Moves += std::count(moved.begin(), moved.end(), 1);
+    // 3D refinement re-tetrahedralises the nodes itself: the last sweep need not.
+    const bool refinedNext = vpc == 4 && p.QualityRefinement && it + 1 == sweeps;
+    if (p.Flips && !refinedNext)
     {
       std::vector<std::int64_t> cells = s.Topology.Cells();
       if (vpc == 3)
       {
-        result.Flips += DelaunayFlips(s.Topology, s.Points, cells);
+        result.Flips += DelaunayFlips(g, s.Points, moved, cells, neighbours);
       }
       else
       {

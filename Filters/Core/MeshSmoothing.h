@@ -1,6 +1,9 @@
 // Stage 3: image-weighted smoothing of an image mesh. Each iteration moves every free node once
-// (Gauss-Seidel, in node order) to its CVT or ODT position under a feature density, then restores
-// the Delaunay property of the moved nodes; tetrahedral meshes finish with sliver removal.
+// (multicolour Gauss-Seidel: nodes greedily coloured in id order so that one colour shares no
+// element, colours in order, a colour's nodes in parallel; the result does not depend on the thread
+// count) to its CVT or ODT position under a feature density, then restores the Delaunay property;
+// Delaunay refinement then adds nodes where the angle bounds are still missed, and tetrahedral
+// meshes finish with sliver perturbation.
 //
 // Density (thesis 2.3): rho(T) = 1 + FeatureWeight * g(T) / mean(g), g(T) the gradient magnitude of
 // the Gaussian-smoothed image averaged over T's centroid and the centroids of the sub-simplices
