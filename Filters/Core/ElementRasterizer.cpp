@@ -1,4 +1,5 @@
 #include "ElementRasterizer.h"
+#include "Vector3.h"
 
 #include <algorithm>
 #include <cmath>
@@ -118,23 +119,7 @@ std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const Par
 
 namespace
 {
-using V3 = std::array<double, 3>;
-V3 Sub(const V3& a, const V3& b)
-{
-  return { { a[0] - b[0], a[1] - b[1], a[2] - b[2] } };
-}
-V3 Cross(const V3& a, const V3& b)
-{
-  return { { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] } };
-}
-double Dot(const V3& a, const V3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-double Norm(const V3& a)
-{
-  return std::sqrt(Dot(a, a));
-}
+using namespace vector3;
 constexpr double Degrees = 180.0 / 3.14159265358979323846;
 } // namespace
 

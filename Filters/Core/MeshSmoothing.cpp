@@ -4,6 +4,7 @@
 #include "ElementRasterizer.h"
 #include "ExactPredicates.h"
 #include "ImageFilters.h"
+#include "Vector3.h"
 
 #include <algorithm>
 #include <chrono>
@@ -16,7 +17,7 @@ namespace featuremesh
 {
 namespace
 {
-using V3 = std::array<double, 3>;
+using namespace vector3;
 
 // Moved positions are multiples of 1 / Lattice voxel in index space.
 constexpr double Lattice = 1024.0;
@@ -25,18 +26,6 @@ constexpr double StepFractions[] = { 1.0, 0.5, 0.25 };
 // A cached value still to compute.
 constexpr double Stale = std::numeric_limits<double>::quiet_NaN();
 
-V3 Sub(const V3& a, const V3& b)
-{
-  return { { a[0] - b[0], a[1] - b[1], a[2] - b[2] } };
-}
-V3 Cross(const V3& a, const V3& b)
-{
-  return { { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] } };
-}
-double Dot(const V3& a, const V3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
 
 // Circumcentre of a triangle (xy) or tetrahedron in frame coordinates; false for a flat element.
 bool Circumcentre(const V3* const* v, int vpc, V3& centre)
@@ -685,7 +674,10 @@ MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<s
   t0 = Clock::now();
   const int sweeps = std::max(0, p.Iterations);
   const bool perturb = vpc == 4 && p.SliverRemoval && sweeps > 0;
-  const double sweepShare = perturb ? 0.8 : 1.0;
+  // Progress: sweeps, then refinement, then slivers.
+  const bool refine = p.QualityRefinement && sweeps > 0;
+  const double sweepShare = refine ? 0.6 : (perturb ? 0.8 : 1.0);
+  const double refineEnd = perturb ? 0.8 : 1.0;
   std::vector<double> elementDensity;
   std::vector<std::int64_t> neighbours = vpc == 3 && p.Flips && sweeps > 0 ? TriangleNeighbours(mesh) : std::vector<std::int64_t>();
   std::vector<std::uint8_t> moved(n);
@@ -797,7 +789,15 @@ MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<s
         std::transform(s.Points.begin(), s.Points.end(), frame.begin(), [&](const V3& q) { return g.IndexToFrame(q); });
         DelaunayOptions o;
         o.Backend = DelaunayBackend::CGAL;
-        DelaunayResult d = Tetrahedralize(frame, o);
+        // CGAL has no progress or abort of its own: it runs beside a heartbeat.
+        DelaunayResult d;
+        const double at = sweepShare * (it + 0.95) / sweeps;
+        if (!RunWithHeartbeat<DelaunayResult>([frame, o]() { return Tetrahedralize(frame, o); },
+              [&](double) { return progress(at); }, d))
+        {
+          result.Aborted = true;
+          return result;
+        }
         if (!d.Error.empty() || d.Points.size() != frame.size())
         {
           result.Error = "re-tetrahedralising the moved nodes failed: " + d.Error;
@@ -816,23 +816,25 @@ MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<s
   }
   result.SweepSeconds = since(t0);
   t0 = Clock::now();
-  if (p.QualityRefinement && sweeps > 0)
+  if (refine)
   {
     std::vector<V3> frame(s.Points.size());
     std::transform(s.Points.begin(), s.Points.end(), frame.begin(), [&](const V3& q) { return g.IndexToFrame(q); });
+    DelaunayOptions o;
+    o.QualityRefinement = true;
+    o.MinDihedralAngle = p.MinDihedralAngle;
+    o.RadiusEdgeRatio = p.RadiusEdgeRatio;
+    o.PreserveBoundary = true;
+    const double minAngle = p.MinAngle;
+    const bool planar = vpc == 3;
+    // TetGen and CGAL's mesher have no progress or abort of their own: they run beside a heartbeat.
     DelaunayResult d;
-    if (vpc == 3)
+    if (!RunWithHeartbeat<DelaunayResult>(
+          [frame, o, minAngle, planar]() { return planar ? RefineQuality2D(frame, minAngle) : Tetrahedralize(frame, o); },
+          SubProgress(progress, sweepShare, refineEnd), d))
     {
-      d = RefineQuality2D(frame, p.MinAngle);
-    }
-    else
-    {
-      DelaunayOptions o;
-      o.QualityRefinement = true;
-      o.MinDihedralAngle = p.MinDihedralAngle;
-      o.RadiusEdgeRatio = p.RadiusEdgeRatio;
-      o.PreserveBoundary = true;
-      d = Tetrahedralize(frame, o);
+      result.Aborted = true;
+      return result;
     }
     if (!d.Error.empty() || d.Points.size() < frame.size())
     {
@@ -856,7 +858,7 @@ MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<s
   t0 = Clock::now();
   if (perturb)
   {
-    result.Perturbed = PerturbSlivers(s, p.SliverAngle, 10, SubProgress(progress, sweepShare, 1.0), result.Aborted);
+    result.Perturbed = PerturbSlivers(s, p.SliverAngle, 10, SubProgress(progress, refine ? refineEnd : sweepShare, 1.0), result.Aborted);
     if (result.Aborted)
     {
       return result;
