@@ -123,6 +123,7 @@ int vtkImageMeshSmoothing::RequestData(
     {
       return fail(error);
     }
+    this->UpdateProgress(0.02);
     std::vector<double> values;
     const bool valuesOk = ChosenValues(image, this->GetInputArrayInformation(0), values, error, warning);
     if (!warning.empty())
@@ -170,6 +171,7 @@ int vtkImageMeshSmoothing::RequestData(
       return 1;
     }
     ElementQuality(result.Mesh, minAngle, radiusRatio, parallel);
+    this->UpdateProgress(0.97);
     const double statisticsSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
     WriteImageMesh(result.Mesh, stats, minAngle, radiusRatio, output);
     PassNodeArrays(input->GetPointData(), nPts, output->GetPointData(), result.Mesh.NumberOfPoints(), nPts);

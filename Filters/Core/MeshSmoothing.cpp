@@ -631,6 +631,11 @@ MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<s
   {
     smoothed.resize(static_cast<size_t>(g.Size()));
     GaussianSmooth(values, smoothed.data(), g, p.Sigma, parallel);
+    if (!progress(0.0))
+    {
+      result.Aborted = true;
+      return result;
+    }
   }
   if (p.FeatureWeight != 0.0 && p.Iterations > 0)
   {
