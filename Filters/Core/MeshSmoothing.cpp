@@ -26,7 +26,6 @@ constexpr double StepFractions[] = { 1.0, 0.5, 0.25 };
 // A cached value still to compute.
 constexpr double Stale = std::numeric_limits<double>::quiet_NaN();
 
-
 // Circumcentre of a triangle (xy) or tetrahedron in frame coordinates; false for a flat element.
 bool Circumcentre(const V3* const* v, int vpc, V3& centre)
 {
@@ -647,7 +646,10 @@ MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<s
   Smoother s(mesh, freeAxes);
   if (slide && !smoothed.empty())
   {
-    s.Slack = p.FixedNodeSlack * std::min(std::fabs(g.Spacing[0]), std::fabs(g.Spacing[1]));
+    // Voxels to frame units: the finest spacing of the image's axes.
+    double finest = std::min(std::fabs(g.Spacing[0]), std::fabs(g.Spacing[1]));
+    finest = g.Is2D() ? finest : std::min(finest, std::fabs(g.Spacing[2]));
+    s.Slack = p.FixedNodeSlack * finest;
     s.Normal.assign(n, V3{ { 0, 0, 0 } });
     for (std::int64_t v = 0; v < n; ++v)
     {
