@@ -677,8 +677,6 @@ MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<s
       }
     }
   }
-  result.DensitySeconds = since(t0);
-  t0 = Clock::now();
   const int sweeps = std::max(0, p.Iterations);
   const bool perturb = vpc == 4 && p.SliverRemoval && sweeps > 0;
   // Progress: sweeps, then refinement, then slivers.

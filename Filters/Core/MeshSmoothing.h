@@ -86,8 +86,8 @@ struct MeshSmoothingResult
   std::int64_t Flips = 0;      // 2D edge flips (3D: tetrahedra changed by re-tetrahedralising)
   std::int64_t Perturbed = 0;  // 3D sliver-removal moves
   std::int64_t AddedNodes = 0; // by quality refinement; they follow the input's points
-  // Seconds: density image, sweeps (with flips / re-tetrahedralisation), refinement, slivers.
-  double DensitySeconds = 0, SweepSeconds = 0, RefinementSeconds = 0, SliverSeconds = 0;
+  // Seconds: sweeps (with the density image and the flips / re-tetrahedralisation), refinement, slivers.
+  double SweepSeconds = 0, RefinementSeconds = 0, SliverSeconds = 0;
   bool Aborted = false;
   std::string Error;
 };
