@@ -32,27 +32,32 @@ for name, proxy in (("Feature Nodes", nodes), ("Delaunay Image Mesh", mesh), ("I
     gap, events, seconds = watch(proxy)
     ft.check(gap <= MAX_GAP, "%s on BraTS: %d progress events over %.2f s, longest gap %.3f s (<= %.1f s)" % (name, events, seconds, gap, MAX_GAP))
 
+def abort_after(proxy, fraction):
+    """Updates the proxy, asking it to abort once its progress passes `fraction`; returns the
+    seconds from the request to the return (None when it was never asked) and whether the output
+    was then empty. The abort flag is cleared afterwards, so the next update runs again."""
+    algorithm = proxy.GetClientSideObject()
+    asked = []
+
+    def abort(o, e):
+        if o.GetProgress() > fraction and not asked:
+            asked.append(time.perf_counter())
+            o.SetAbortExecute(1)
+
+    tag = algorithm.AddObserver("ProgressEvent", abort)
+    proxy.UpdatePipeline()
+    returned = time.perf_counter()
+    algorithm.RemoveObserver(tag)
+    empty = ft.fetch(proxy).GetNumberOfPoints() == 0
+    algorithm.SetAbortExecute(0)
+    return (returned - asked[0] if asked else None), empty
+
+
 # Abort in the middle of the voxel cut's max-flow (its longest step), from a progress observer.
 vc = case.voxel_cut()
-algorithm = vc.GetClientSideObject()
-asked = []
-
-
-def abort_in_flow(o, e):
-    if o.GetProgress() > 0.7 and not asked:
-        asked.append(time.perf_counter())
-        o.SetAbortExecute(1)
-
-
-tag = algorithm.AddObserver("ProgressEvent", abort_in_flow)
-vc.UpdatePipeline()
-returned = time.perf_counter()
-algorithm.RemoveObserver(tag)
-ft.check(bool(asked), "the abort was asked during the flow")
-if asked:
-    ft.check(returned - asked[0] < 1.0, "Voxel Cut returns %.2f s after the abort (< 1 s)" % (returned - asked[0]))
-ft.check(ft.fetch(vc).GetNumberOfPoints() == 0, "the aborted output is empty")
-algorithm.SetAbortExecute(0)
+after, empty = abort_after(vc, 0.7)
+ft.check(after is not None and after < 1.0, "Voxel Cut returns %.2f s after an abort during the flow (< 1 s)" % (after or -1))
+ft.check(empty, "the aborted output is empty")
 vc.UpdatePipeline()
 labels = ft.fm.labels(vc, 0)
 ft.check(labels.size == 240 * 240 * 155 and 0 < labels.sum() < labels.size, "the next update runs the cut again (%d object voxels)" % labels.sum())
@@ -70,23 +75,8 @@ ft.check(ft.fetch(sv).GetNumberOfCells() > 0, "and runs again on the next update
 
 # Image Mesh Smoothing, aborted during its refinement (TetGen runs beside a heartbeat).
 sm = case.smoothing(mesh)
-algorithm = sm.GetClientSideObject()
-asked = []
-
-
-def abort_in_refinement(o, e):
-    if o.GetProgress() > 0.45 and not asked:
-        asked.append(time.perf_counter())
-        o.SetAbortExecute(1)
-
-
-tag = algorithm.AddObserver("ProgressEvent", abort_in_refinement)
-sm.UpdatePipeline()
-returned = time.perf_counter()
-algorithm.RemoveObserver(tag)
-ft.check(bool(asked) and returned - asked[0] < 1.0, "Image Mesh Smoothing returns %.2f s after the abort (< 1 s)" % (
-    returned - asked[0] if asked else -1))
-ft.check(ft.fetch(sm).GetNumberOfCells() == 0, "an aborted Image Mesh Smoothing has an empty output")
-algorithm.SetAbortExecute(0)
+after, empty = abort_after(sm, 0.45)
+ft.check(after is not None and after < 1.0, "Image Mesh Smoothing returns %.2f s after an abort during refinement (< 1 s)" % (after or -1))
+ft.check(empty, "an aborted Image Mesh Smoothing has an empty output")
 sm.UpdatePipeline()
 ft.check(ft.fetch(sm).GetNumberOfCells() > ft.fetch(mesh).GetNumberOfCells(), "and runs again on the next update")
