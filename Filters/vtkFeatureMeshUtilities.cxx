@@ -215,6 +215,19 @@ bool SameFrame(const ImageGeometry& a, const ImageGeometry& b)
   return true;
 }
 
+bool MeshMatchesImage(vtkDataObject* mesh, const ImageGeometry& frame, std::string& error)
+{
+  ImageGeometry recorded;
+  std::string ignored;
+  if (ImageGeometryFromFieldData(mesh, recorded, ignored) && !SameFrame(recorded, frame))
+  {
+    error = "the mesh was made on another image grid than the connected Image (dimensions, origin, spacing or "
+            "direction differ); connect the image the mesh was made from.";
+    return false;
+  }
+  return true;
+}
+
 void SetImageFrame(vtkImageData* image, const ImageGeometry& g)
 {
   image->SetExtent(0, g.Dims[0] - 1, 0, g.Dims[1] - 1, 0, g.Dims[2] - 1);

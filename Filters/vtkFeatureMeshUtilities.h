@@ -104,6 +104,10 @@ bool ImageGeometryFromFieldData(vtkDataObject* object, ImageGeometry& geometry, 
 // True when two frames describe the same grid (to 1e-9 of the spacing).
 bool SameFrame(const ImageGeometry& a, const ImageGeometry& b);
 
+// False, with a sentence, when `mesh` records an image frame (field data) that differs from the
+// connected image's `frame`; a mesh without a recorded frame matches.
+bool MeshMatchesImage(vtkDataObject* mesh, const ImageGeometry& frame, std::string& error);
+
 // Gives `image` the frame's extent (from 0), origin, spacing and direction.
 void SetImageFrame(vtkImageData* image, const ImageGeometry& geometry);
 

@@ -102,16 +102,10 @@ int vtkImageMeshSmoothing::RequestData(
       return fail("the mesh has no PixelCount and MeanIntensity cell arrays; make it with Delaunay Image Mesh.");
     }
     // The image's frame; a mesh that records its own must match it.
-    ImageGeometry geometry, meshFrame;
-    if (!ImageGeometryOf(image, geometry, error))
+    ImageGeometry geometry;
+    if (!ImageGeometryOf(image, geometry, error) || !MeshMatchesImage(input, geometry, error))
     {
       return fail(error);
-    }
-    std::string ignored;
-    if (ImageGeometryFromFieldData(input, meshFrame, ignored) && !SameFrame(meshFrame, geometry))
-    {
-      return fail("the mesh was made on another image grid than the connected Image (dimensions, origin, spacing or "
-                  "direction differ); connect the image the mesh was made from.");
     }
     if (par.Iterations == 0)
     {
@@ -124,13 +118,16 @@ int vtkImageMeshSmoothing::RequestData(
       return fail(error);
     }
     this->UpdateProgress(0.02);
-    std::vector<double> values;
-    const bool valuesOk = ChosenValues(image, this->GetInputArrayInformation(0), values, error, warning);
+    // Doubles for the exact statistics; floats for the density (the array itself when it is float).
+    vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
     if (!warning.empty())
     {
       vtkWarningMacro("Image Mesh Smoothing: " << warning);
     }
-    if (!valuesOk)
+    std::vector<double> values;
+    std::vector<float> floatStorage;
+    const float* floats = array && ToDouble(array, values, error) ? FloatValues(array, floatStorage, error) : nullptr;
+    if (!floats)
     {
       return fail(error);
     }
@@ -150,9 +147,8 @@ int vtkImageMeshSmoothing::RequestData(
     const double before = minAngle.empty() ? 0.0 : *std::min_element(minAngle.begin(), minAngle.end());
     this->UpdateProgress(0.05);
 
-    const std::vector<float> floats(values.begin(), values.end());
     auto t0 = Clock::now();
-    MeshSmoothingResult result = SmoothImageMesh(mesh, fixed, floats.data(), par, parallel, AlgorithmProgress(this, 0.05, 0.6));
+    MeshSmoothingResult result = SmoothImageMesh(mesh, fixed, floats, par, parallel, AlgorithmProgress(this, 0.05, 0.6));
     if (result.Aborted)
     {
       return 1;

@@ -144,12 +144,9 @@ int vtkSuperVoxelCut::RequestData(
     {
       return fail(error);
     }
-    ImageGeometry meshFrame;
-    std::string ignored;
-    if (image && ImageGeometryFromFieldData(input, meshFrame, ignored) && !SameFrame(meshFrame, geometry))
+    if (image && !MeshMatchesImage(input, geometry, error))
     {
-      return fail("the mesh was made on another image grid than the connected Image (dimensions, origin, spacing or "
-                  "direction differ); connect the image the mesh was made from.");
+      return fail(error);
     }
     SimplexMesh mesh;
     if (!ToSimplexMesh(input, geometry, mesh, error))
