@@ -38,6 +38,13 @@ constexpr const char* RadiusRatio = "RadiusRatio";         // 1 = equilateral
 constexpr const char* Label = "Label";
 // Stage 1's edge-map image.
 constexpr const char* EdgeMap = "EdgeMap";
+// Stage 5's image (the input grid): paths per voxel, the marching maps, the 2D contour's region,
+// and the role of each sample point (0 source, 1 sink).
+constexpr const char* EdgeConfidence = "EdgeConfidence";         // float
+constexpr const char* ObjectDistance = "ObjectDistance";         // float, +inf beyond the sampling threshold
+constexpr const char* BackgroundDistance = "BackgroundDistance"; // float
+constexpr const char* ContourRegion = "ContourRegion";           // uint8, 1 = enclosed by the final contour
+constexpr const char* SampleRole = "SampleRole";                 // uint8
 
 // Field data: the image frame a mesh was made on (3, 3, 3 and 9 components; direction row-major).
 constexpr const char* ImageOrigin = "ImageOrigin";
@@ -67,6 +74,15 @@ constexpr const char* SmoothingSeconds = "SmoothingSeconds";
 constexpr const char* SweepSeconds = "SweepSeconds";
 constexpr const char* RefinementSeconds = "RefinementSeconds";
 constexpr const char* SliverSeconds = "SliverSeconds";
+// Stage 5.
+constexpr const char* Paths = "Paths";
+constexpr const char* PathVoxels = "PathVoxels";
+constexpr const char* PathGridFactor = "PathGridFactor";
+constexpr const char* ObjectThreshold = "ObjectThreshold";
+constexpr const char* BackgroundThreshold = "BackgroundThreshold";
+constexpr const char* GradientRange = "GradientRange";
+constexpr const char* MarchingSeconds = "MarchingSeconds";
+constexpr const char* PathSeconds = "PathSeconds";
 constexpr const char* Sigma = "Sigma";
 constexpr const char* Bins = "Bins";
 constexpr const char* Flow = "Flow";

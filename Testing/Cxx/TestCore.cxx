@@ -8,6 +8,7 @@
 #include "Halftoning.h"
 #include "ImageFilters.h"
 #include "MeshSmoothing.h"
+#include "RSPEdgeEnhancement.h"
 #include "ExactPredicates.h"
 #include "SimplexMesh.h"
 #include "SeedConnectivity.h"
@@ -1312,4 +1313,183 @@ TEST(MeshSmoothing, BadParametersAreNamed)
   p = MeshSmoothingParameters();
   p.FixedNodeSlack = -1;
   EXPECT_NE(ValidateParameters(p).find("slack"), std::string::npos);
+}
+
+//------------------------------------------------------------------------------------------------
+// Stage 5: RSP edge enhancement.
+namespace
+{
+// A bright disk (radius r) on a dark background, with mild deterministic texture.
+std::vector<float> DiskImage(const ImageGeometry& g, double cx, double cy, double r)
+{
+  std::vector<float> f(g.Size());
+  for (int j = 0; j < g.Dims[1]; ++j)
+    for (int i = 0; i < g.Dims[0]; ++i)
+      f[g.Index(i, j, 0)] = (std::hypot(i - cx, j - cy) <= r ? 200.f : 40.f) + static_cast<float>((i * 7 + j * 13) % 5);
+  return f;
+}
+} // namespace
+
+TEST(RSPEdgeEnhancement, FastMarchingOnAConstantImageIsEuclidean)
+{
+  // 2D, a point source: first-order error grows like h log(r); 3D with spacing 2 along x.
+  ImageGeometry g = Grid2(81, 81);
+  std::vector<float> ones(g.Size(), 1.f);
+  std::vector<float> T = FastMarching(ones.data(), g, { g.Index(40, 40, 0) }, 0.0);
+  double worst = 0.0;
+  for (int j = 0; j < 81; ++j)
+    for (int i = 0; i < 81; ++i)
+    {
+      const double r = std::hypot(i - 40, j - 40), t = T[g.Index(i, j, 0)];
+      EXPECT_GE(t, r - 1e-9);
+      EXPECT_LE(t - r, 0.35 * (1.0 + std::log(1.0 + r))) << i << " " << j;
+      if (r >= 20.0)
+        worst = std::max(worst, (t - r) / r);
+    }
+  EXPECT_LT(worst, 0.05);
+  EXPECT_DOUBLE_EQ(T[g.Index(70, 40, 0)], 30.0); // along an axis it is exact
+  ImageGeometry g3;
+  g3.Dims = { { 21, 31, 31 } };
+  g3.Spacing = { { 2, 1, 1 } };
+  std::vector<float> ones3(g3.Size(), 1.f);
+  std::vector<float> T3 = FastMarching(ones3.data(), g3, { g3.Index(10, 15, 15) }, 0.0);
+  EXPECT_DOUBLE_EQ(T3[g3.Index(20, 15, 15)], 20.0);
+  EXPECT_DOUBLE_EQ(T3[g3.Index(10, 30, 15)], 15.0);
+  const double r = std::sqrt(20.0 * 20.0 + 15.0 * 15.0 + 15.0 * 15.0);
+  EXPECT_NEAR(T3[g3.Index(20, 30, 30)], r, 0.12 * r);
+  // Marching stops past stopAt: farther voxels stay infinite.
+  std::vector<float> Tstop = FastMarching(ones.data(), g, { g.Index(40, 40, 0) }, 10.0);
+  EXPECT_TRUE(std::isinf(Tstop[g.Index(70, 40, 0)]));
+  EXPECT_DOUBLE_EQ(Tstop[g.Index(50, 40, 0)], 10.0);
+}
+
+TEST(RSPEdgeEnhancement, PathsCrossATwoPlateauImageAtTheStep)
+{
+  ImageGeometry g = Grid2(64, 48);
+  std::vector<float> f(g.Size());
+  for (int j = 0; j < 48; ++j)
+    for (int i = 0; i < 64; ++i)
+      f[g.Index(i, j, 0)] = i < 32 ? 20.f : 220.f;
+  RSPParameters p;
+  p.GradientSigma = 0.0;
+  const RSPResult r = RSPEdgeEnhancement(
+    f.data(), g, { g.Index(8, 24, 0) }, { g.Index(56, 24, 0) }, p, SerialFor(), NoProgress());
+  ASSERT_TRUE(r.Error.empty()) << r.Error;
+  EXPECT_EQ(r.Paths, 50 * 100);
+  // The brightest column is at the step, and the step's two columns carry far more than any other.
+  std::vector<double> column(64, 0.0);
+  for (int j = 0; j < 48; ++j)
+    for (int i = 0; i < 64; ++i)
+      column[i] += r.EdgeConfidence[g.Index(i, j, 0)];
+  const int top = static_cast<int>(std::max_element(column.begin(), column.end()) - column.begin());
+  EXPECT_TRUE(top == 31 || top == 32) << top;
+  double other = 0.0;
+  for (int i = 0; i < 64; ++i)
+    if (i < 30 || i > 33)
+      other = std::max(other, column[i]);
+  EXPECT_GT(column[31] + column[32], 5.0 * other);
+  // Every path crosses the step exactly where it is: each of the 5000 paths holds a voxel of
+  // column 31 and one of column 32.
+  EXPECT_GE(column[31], 5000.0);
+  EXPECT_GE(column[32], 5000.0);
+}
+
+TEST(RSPEdgeEnhancement, SourcesFallInsideTheDiskAndSinksOutside)
+{
+  ImageGeometry g = Grid2(96, 96);
+  const std::vector<float> f = DiskImage(g, 48, 48, 20);
+  const std::vector<std::int64_t> object{ g.Index(48, 48, 0), g.Index(40, 52, 0) };
+  const std::vector<std::int64_t> background{ g.Index(20, 20, 0), g.Index(80, 30, 0), g.Index(48, 80, 0),
+    g.Index(15, 60, 0) };
+  RSPParameters p;
+  const RSPResult r = RSPEdgeEnhancement(f.data(), g, object, background, p, SerialFor(), NoProgress());
+  ASSERT_TRUE(r.Error.empty()) << r.Error;
+  ASSERT_EQ(r.SourceVoxels.size(), 50u);
+  ASSERT_EQ(r.SinkVoxels.size(), 100u);
+  const auto inDisk = [&](std::int64_t v) { return std::hypot(v % 96 - 48.0, v / 96 - 48.0) <= 20.0; };
+  const auto sourcesIn = std::count_if(r.SourceVoxels.begin(), r.SourceVoxels.end(), inDisk);
+  const auto sinksOut = std::count_if(r.SinkVoxels.begin(), r.SinkVoxels.end(), [&](std::int64_t v) { return !inDisk(v); });
+  EXPECT_GE(sourcesIn, 40); // >= 80 %
+  EXPECT_GE(sinksOut, 80);
+  // The sampler itself: on a map that is the distance from the centre, with T = 20, P(taken) falls
+  // linearly with the distance: the density of the draws is r (1 - r / 20), 90 % of it within 16.
+  std::vector<float> map(g.Size());
+  for (std::int64_t v = 0; v < g.Size(); ++v)
+    map[v] = static_cast<float>(std::hypot(v % 96 - 48.0, v / 96 - 48.0));
+  const std::vector<std::int64_t> s = RejectionSample(map, 20.0, 200, 7);
+  ASSERT_EQ(s.size(), 200u);
+  const auto near = std::count_if(s.begin(), s.end(), [&](std::int64_t v) { return map[v] <= 16.f; });
+  EXPECT_GE(near, 160);
+  EXPECT_EQ(s, RejectionSample(map, 20.0, 200, 7));
+  EXPECT_NE(s, RejectionSample(map, 20.0, 200, 8));
+}
+
+TEST(RSPEdgeEnhancement, EdgeConfidenceFollowsTheDiskAndTheContourClosesAroundIt)
+{
+  ImageGeometry g = Grid2(96, 96);
+  const std::vector<float> f = DiskImage(g, 48, 48, 20);
+  const std::vector<std::int64_t> object{ g.Index(48, 48, 0), g.Index(40, 52, 0) };
+  const std::vector<std::int64_t> background{ g.Index(20, 20, 0), g.Index(80, 30, 0), g.Index(48, 80, 0),
+    g.Index(15, 60, 0) };
+  RSPParameters p;
+  const RSPResult r = RSPEdgeEnhancement(f.data(), g, object, background, p, SerialFor(), NoProgress());
+  ASSERT_TRUE(r.Error.empty()) << r.Error;
+  double nearSum = 0, farSum = 0;
+  int nearCount = 0, farCount = 0;
+  for (std::int64_t v = 0; v < g.Size(); ++v)
+  {
+    const double d = std::fabs(std::hypot(v % 96 - 48.0, v / 96 - 48.0) - 20.0);
+    if (d <= 1.0)
+      nearSum += r.EdgeConfidence[v], ++nearCount;
+    else if (d > 5.0)
+      farSum += r.EdgeConfidence[v], ++farCount;
+  }
+  EXPECT_GT(nearSum / nearCount, 5.0 * farSum / farCount);
+  // The contour: consecutive voxels (and last to first) are 4-neighbours, no voxel twice.
+  ASSERT_GT(r.Contour.size(), 20u);
+  std::set<std::int64_t> seen;
+  for (std::size_t i = 0; i < r.Contour.size(); ++i)
+  {
+    const std::int64_t a = r.Contour[i], b = r.Contour[(i + 1) % r.Contour.size()];
+    EXPECT_EQ(std::abs(a % 96 - b % 96) + std::abs(a / 96 - b / 96), 1);
+    EXPECT_TRUE(seen.insert(a).second);
+  }
+  std::int64_t both = 0, region = 0, disk = 0;
+  for (std::int64_t v = 0; v < g.Size(); ++v)
+  {
+    const bool in = std::hypot(v % 96 - 48.0, v / 96 - 48.0) <= 20.0;
+    both += in && r.Region[v];
+    region += r.Region[v];
+    disk += in;
+  }
+  EXPECT_GT(2.0 * both / (region + disk), 0.9);
+  // Split-invariant: the same EC for any split of the sources.
+  const RSPResult c = RSPEdgeEnhancement(f.data(), g, object, background, p, Chunked, NoProgress());
+  EXPECT_EQ(c.EdgeConfidence, r.EdgeConfidence);
+  EXPECT_EQ(c.Contour, r.Contour);
+  p.RandomSeed = 3;
+  const RSPResult other = RSPEdgeEnhancement(f.data(), g, object, background, p, SerialFor(), NoProgress());
+  EXPECT_NE(other.SourceVoxels, r.SourceVoxels);
+}
+
+TEST(RSPEdgeEnhancement, BadInputIsNamed)
+{
+  ImageGeometry g = Grid2(32, 32);
+  std::vector<float> flat(g.Size(), 5.f);
+  RSPParameters p;
+  RSPResult r = RSPEdgeEnhancement(flat.data(), g, { 10 }, { 500 }, p, SerialFor(), NoProgress());
+  EXPECT_NE(r.Error.find("constant"), std::string::npos) << r.Error;
+  const std::vector<float> f = DiskImage(g, 16, 16, 8);
+  r = RSPEdgeEnhancement(f.data(), g, { 10, 20 }, { 20 }, p, SerialFor(), NoProgress());
+  EXPECT_NE(r.Error.find("both"), std::string::npos) << r.Error;
+  r = RSPEdgeEnhancement(f.data(), g, {}, { 20 }, p, SerialFor(), NoProgress());
+  EXPECT_FALSE(r.Error.empty());
+  p.Sources = 0;
+  EXPECT_FALSE(ValidateParameters(p).empty());
+  p = RSPParameters();
+  p.EdgeThreshold = 2;
+  EXPECT_FALSE(ValidateParameters(p).empty());
+  p = RSPParameters();
+  p.GradientSigma = -1;
+  EXPECT_FALSE(ValidateParameters(p).empty());
 }

@@ -44,7 +44,8 @@ def load_plugin(path=None, ns=None):
         ps.LoadPlugin(path or find_plugin(), ns=None)
         _loaded.append(True)
     if ns is not None:
-        for name in ("FeatureNodes", "DelaunayImageMesh", "ImageMeshSmoothing", "SuperVoxelCut", "VoxelCut"):
+        for name in ("FeatureNodes", "DelaunayImageMesh", "ImageMeshSmoothing", "RSPEdgeEnhancement", "SuperVoxelCut",
+                     "VoxelCut"):
             ns[name] = getattr(ps, name)
 
 
@@ -102,8 +103,15 @@ class Case:
         path = os.path.join(self.folder, "truth.mha")
         return v2n(fetch(ps.OpenDataFile(path)).GetPointData().GetScalars()) if os.path.isfile(path) else None
 
-    def feature_nodes(self, **properties):
+    def feature_nodes(self, edges=None, **properties):
+        """Feature Nodes; `edges` (an RSP Edge Enhancement proxy) feeds its Edge Map input."""
+        if edges is not None:
+            properties["EdgeMap"] = edges
         return ps.FeatureNodes(Input=self.image, Scalars=self.scalars, **properties)
+
+    def rsp(self, **properties):
+        return ps.RSPEdgeEnhancement(Input=self.image, ObjectSeeds=self.object_seeds,
+                                     BackgroundSeeds=self.background_seeds, Scalars=self.scalars, **properties)
 
     def mesh(self, nodes, **properties):
         return ps.DelaunayImageMesh(Nodes=nodes, Image=self.image, Scalars=self.scalars, **properties)
