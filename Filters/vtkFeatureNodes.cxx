@@ -40,6 +40,9 @@ vtkFeatureNodes::vtkFeatureNodes()
   this->ExclusionWindow = defaults.ExclusionWindow;
   this->UniformSpacing = defaults.UniformSpacing;
   this->BoundarySpacing = defaults.BoundarySpacing;
+  this->SeedAware = defaults.SeedAware;
+  this->EdgeGateRadius = defaults.EdgeGateRadius;
+  this->CoarseningLevels = defaults.CoarseningLevels;
   this->SetNumberOfInputPorts(2);
   this->SetNumberOfOutputPorts(2);
   this->SetInputArrayToProcess(
@@ -124,6 +127,9 @@ int vtkFeatureNodes::Execute(vtkInformationVector** inputVector, vtkInformationV
   p.ExclusionWindow = this->ExclusionWindow;
   p.UniformSpacing = this->UniformSpacing;
   p.BoundarySpacing = this->BoundarySpacing;
+  p.SeedAware = this->SeedAware;
+  p.EdgeGateRadius = this->EdgeGateRadius;
+  p.CoarseningLevels = this->CoarseningLevels;
   error = ValidateParameters(p);
   if (!error.empty())
   {
@@ -148,7 +154,12 @@ int vtkFeatureNodes::Execute(vtkInformationVector** inputVector, vtkInformationV
   std::vector<std::uint8_t> edgeValues;
   if (edgeInput)
   {
-    vtkDataArray* edgeArray = edgeInput->GetPointData()->GetScalars();
+    // RSP Edge Enhancement's image carries EdgeMap beside its active EdgeConfidence.
+    vtkDataArray* edgeArray = edgeInput->GetPointData()->GetArray(names::EdgeMap);
+    if (!edgeArray)
+    {
+      edgeArray = edgeInput->GetPointData()->GetScalars();
+    }
     if (!edgeArray && edgeInput->GetPointData()->GetNumberOfArrays() > 0)
     {
       edgeArray = edgeInput->GetPointData()->GetArray(0);
@@ -263,4 +274,7 @@ void vtkFeatureNodes::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ExclusionWindow: " << this->ExclusionWindow << "\n";
   os << indent << "UniformSpacing: " << this->UniformSpacing << "\n";
   os << indent << "BoundarySpacing: " << this->BoundarySpacing << "\n";
+  os << indent << "SeedAware: " << this->SeedAware << "\n";
+  os << indent << "EdgeGateRadius: " << this->EdgeGateRadius << "\n";
+  os << indent << "CoarseningLevels: " << this->CoarseningLevels << "\n";
 }

@@ -73,7 +73,19 @@ public:
   vtkSetMacro(BoundarySpacing, int);
   vtkGetMacro(BoundarySpacing, int);
 
-  /// Optional edge map (port 1): its non-zero voxels replace Canny's edges.
+  /// With an Edge Map connected: seed-aware recipe (default on; see featuremesh::FeatureNodeParameters)
+  /// or, off, the map replaces Canny's edges. Gate radius (voxels) of the Canny edges
+  /// kept near the map (default 20); coarsening levels (default 3) of the fill away from the edges.
+  vtkSetMacro(SeedAware, bool);
+  vtkGetMacro(SeedAware, bool);
+  vtkBooleanMacro(SeedAware, bool);
+  vtkSetMacro(EdgeGateRadius, int);
+  vtkGetMacro(EdgeGateRadius, int);
+  vtkSetMacro(CoarseningLevels, int);
+  vtkGetMacro(CoarseningLevels, int);
+
+  /// Optional edge map (port 1): its EdgeMap point array (else its scalars, else its first array),
+  /// non-zero = edge.
   void SetEdgeMapConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(1, output); }
 
 protected:
@@ -100,6 +112,9 @@ protected:
   int ExclusionWindow;
   int UniformSpacing;
   int BoundarySpacing;
+  bool SeedAware;
+  int EdgeGateRadius;
+  int CoarseningLevels;
 
 private:
   // The pipeline state of the last failed run (0: none), so that it is not repeated.

@@ -141,6 +141,14 @@ std::string ValidateParameters(const FeatureNodeParameters& p)
   {
     return "uniform and boundary spacings must be at least one voxel.";
   }
+  if (p.EdgeGateRadius < 0 || p.EdgeGateRadius > 1000)
+  {
+    return "the edge gate radius must lie in [0, 1000] voxels.";
+  }
+  if (p.CoarseningLevels < 0 || p.CoarseningLevels > 6)
+  {
+    return "the coarsening levels must lie in [0, 6].";
+  }
   return std::string();
 }
 
@@ -182,8 +190,24 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
   }
   t0 = Clock::now();
 
-  // 1. Edges: Canny, or the supplied edge map.
-  if (edgeInput)
+  // 1. Edges: Canny, the supplied edge map, or (seed-aware) the map and the Canny edges near it.
+  const bool seedAware = edgeInput && p.SeedAware;
+  // Seed-aware: every Canny edge still keeps halftone points off itself (they would crowd edges
+  // the mesh is not meant to follow).
+  std::vector<std::uint8_t> allCanny;
+  if (seedAware)
+  {
+    const std::vector<float> fromMap = DistanceToMask(edgeInput, g, parallel);
+    allCanny = CannyEdges(f, g, p.LowThreshold, p.HighThreshold, p.MaximumPercentile, parallel,
+      &out.GradientMaximum, work);
+    const float gate = static_cast<float>(p.EdgeGateRadius);
+    out.EdgeMap.resize(n);
+    for (std::int64_t i = 0; i < n; ++i)
+    {
+      out.EdgeMap[i] = edgeInput[i] || (allCanny[i] && fromMap[i] <= gate) ? 1 : 0;
+    }
+  }
+  else if (edgeInput)
   {
     out.EdgeMap.assign(edgeInput, edgeInput + n);
     for (auto& v : out.EdgeMap)
@@ -268,6 +292,28 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
     out.Counts[static_cast<int>(type)]++;
   };
 
+  // Seed-aware: the distance from the edges sets how coarse the fill may be; a lattice point of
+  // level l keeps every 2^l-th position (nested lattices, so the levels join without gaps).
+  std::vector<float> fromEdges;
+  if (seedAware)
+  {
+    fromEdges = DistanceToMask(out.EdgeMap.data(), g, parallel);
+  }
+  const auto level = [&](int i, int j, int k) {
+    if (fromEdges.empty())
+    {
+      return 0;
+    }
+    const double d = fromEdges[g.Index(i, j, k)];
+    int l = 0;
+    while (l < p.CoarseningLevels && d >= ((1 << (l + 2)) - 2) * static_cast<double>(p.UniformSpacing))
+    {
+      ++l;
+    }
+    return l;
+  };
+  const auto onLevel = [](int index, int last, int l) { return index == last || index % (1 << l) == 0; };
+
   // 3. Boundary nodes: corners always, evenly spaced along the border (2D) or on the box faces (3D).
   t0 = Clock::now();
   {
@@ -276,14 +322,21 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
     const std::vector<int> pz = EvenPositions(g.Dims[2], p.BoundarySpacing);
     const float r = 0.5f * p.BoundarySpacing;
     const int lx = g.Dims[0] - 1, ly = g.Dims[1] - 1, lz = g.Dims[2] - 1;
-    for (int k : pz)
+    const int nx = static_cast<int>(px.size()), ny = static_cast<int>(py.size()), nz = static_cast<int>(pz.size());
+    for (int c = 0; c < nz; ++c)
     {
-      for (int j : py)
+      for (int b = 0; b < ny; ++b)
       {
-        for (int i : px)
+        for (int a = 0; a < nx; ++a)
         {
+          const int i = px[a], j = py[b], k = pz[c];
           const bool onFace = i == 0 || i == lx || j == 0 || j == ly || (!is2D && (k == 0 || k == lz));
-          if (onFace)
+          if (!onFace)
+          {
+            continue;
+          }
+          const int l = level(i, j, k);
+          if (onLevel(a, nx - 1, l) && onLevel(b, ny - 1, l) && onLevel(c, nz - 1, l))
           {
             add(i, j, k, NodeType::Boundary, r);
           }
@@ -314,6 +367,18 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
       rho = f;
     }
     HessianFeatureMap(fh, g, p.HalftoneGamma, p.FeaturePercentile, parallel, rho, &out.FeatureMaximum);
+    if (seedAware)
+    {
+      // The thesis's density within s of the edges that matter, a Gaussian falloff beyond.
+      const double s = p.UniformSpacing;
+      parallel(n, 1 << 16, [&](std::int64_t b, std::int64_t e) {
+        for (std::int64_t i = b; i < e; ++i)
+        {
+          const double x = std::max(0.0, fromEdges[i] - s) / s;
+          rho[i] *= static_cast<float>(std::exp(-x * x));
+        }
+      });
+    }
     out.StepSeconds.emplace_back("hessian", SecondsSince(t0));
     if (!progress(0.8))
     {
@@ -326,7 +391,7 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
     {
       int i, j, k;
       Coordinates(g, d, i, j, k);
-      if (!AnyInBox(out.EdgeMap, g, i, j, k, h))
+      if (!AnyInBox(out.EdgeMap, g, i, j, k, h) && (allCanny.empty() || !AnyInBox(allCanny, g, i, j, k, h)))
       {
         add(i, j, k, NodeType::Halftone, static_cast<float>(h));
       }
@@ -351,6 +416,12 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
       {
         for (int i = start; i < g.Dims[0]; i += s)
         {
+          const int l = level(i, j, k);
+          const int m = 1 << l;
+          if (((i - start) / s) % m || ((j - start) / s) % m || (!is2D && ((k - start) / s) % m))
+          {
+            continue;
+          }
           if (!AnyInBox(occupied, g, i, j, k, h))
           {
             add(i, j, k, NodeType::Uniform, 0.5f * s);

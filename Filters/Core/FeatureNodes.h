@@ -44,6 +44,16 @@ struct FeatureNodeParameters
   int ExclusionWindow = 7;
   int UniformSpacing = 7;
   int BoundarySpacing = 7;
+  // With an edge map supplied (a sparse, seed-driven one such as RSP Edge Enhancement's), SeedAware
+  // makes the mesh fine at those edges and coarse away from them: the edges are the map plus the
+  // Canny edges within EdgeGateRadius voxels of it; the halftone map is kept within s of the edges and damped by
+  // exp(-((d - s) / s)^2) beyond, and
+  // the uniform and boundary spacings double at distances 2s, 6s, 14s ... from the edges (s =
+  // UniformSpacing, at most CoarseningLevels doublings). Off: the map replaces Canny, nothing else
+  // changes (the thesis's use). Without an edge map these have no effect.
+  bool SeedAware = true;
+  int EdgeGateRadius = 20;
+  int CoarseningLevels = 3;
 };
 
 struct FeatureNodeResult

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace featuremesh
@@ -391,5 +392,87 @@ void HessianFeatureMap(const float* f, const ImageGeometry& g, double gamma, dou
       rho[i] = gam == 1.f ? v : std::pow(v, gam);
     }
   });
+}
+
+namespace
+{
+// Squared distance transform of one line: d[q] = min_p (q - p)^2 + f[p] (f = Far where unset).
+void LowerEnvelope(const double* f, int n, double* d, int* v, double* z)
+{
+  int k = 0;
+  v[0] = 0;
+  z[0] = -std::numeric_limits<double>::infinity();
+  z[1] = std::numeric_limits<double>::infinity();
+  for (int q = 1; q < n; ++q)
+  {
+    double s;
+    for (;;)
+    {
+      const int r = v[k];
+      s = ((f[q] + double(q) * q) - (f[r] + double(r) * r)) / (2.0 * (q - r));
+      if (s > z[k])
+      {
+        break;
+      }
+      --k; // z[0] = -inf ends this
+    }
+    ++k;
+    v[k] = q;
+    z[k] = s;
+    z[k + 1] = std::numeric_limits<double>::infinity();
+  }
+  k = 0;
+  for (int q = 0; q < n; ++q)
+  {
+    while (z[k + 1] < q)
+    {
+      ++k;
+    }
+    d[q] = double(q - v[k]) * (q - v[k]) + f[v[k]];
+  }
+}
+} // namespace
+
+std::vector<float> DistanceToMask(const std::uint8_t* mask, const ImageGeometry& g, const ParallelFor& parallel)
+{
+  const std::int64_t n = g.Size();
+  // Far: larger than any squared distance in an image, small enough that differences of squares
+  // next to it stay exact to 1e-4.
+  constexpr double Far = 1e12;
+  std::vector<double> sq(static_cast<std::size_t>(n));
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    sq[i] = mask[i] ? 0.0 : Far;
+  }
+  const std::int64_t stride[3] = { 1, g.Dims[0], g.SliceStride() };
+  for (int a = 0; a < g.Dimension(); ++a)
+  {
+    const int len = g.Dims[a];
+    const int b = a == 0 ? 1 : 0, c = a == 2 ? 1 : 2;
+    const std::int64_t lines = static_cast<std::int64_t>(g.Dims[b]) * g.Dims[c];
+    parallel(lines, 64, [&](std::int64_t l0, std::int64_t l1) {
+      std::vector<double> f(len), d(len), z(len + 1);
+      std::vector<int> v(len);
+      for (std::int64_t l = l0; l < l1; ++l)
+      {
+        const std::int64_t base = (l % g.Dims[b]) * stride[b] + (l / g.Dims[b]) * stride[c];
+        for (int q = 0; q < len; ++q)
+        {
+          f[q] = sq[base + q * stride[a]];
+        }
+        LowerEnvelope(f.data(), len, d.data(), v.data(), z.data());
+        for (int q = 0; q < len; ++q)
+        {
+          sq[base + q * stride[a]] = std::min(d[q], Far);
+        }
+      }
+    });
+  }
+  std::vector<float> out(static_cast<std::size_t>(n));
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    out[i] = sq[i] >= 0.5 * Far ? std::numeric_limits<float>::infinity() : static_cast<float>(std::sqrt(sq[i]));
+  }
+  return out;
 }
 } // namespace featuremesh

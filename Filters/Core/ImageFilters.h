@@ -21,6 +21,11 @@ void GaussianSmooth(const float* in, float* out, const ImageGeometry& grid, doub
 // Gradient magnitude by central differences (one-sided on the border), in voxel units.
 void GradientMagnitude(const float* image, const ImageGeometry& grid, float* magnitude, const ParallelFor& parallel);
 
+// Euclidean distance (voxels, the index grid) from each voxel to the nearest non-zero voxel of
+// `mask`; +inf everywhere when there is none. Exact: Felzenszwalb and Huttenlocher's separable
+// lower envelope of parabolas, one axis after the other.
+std::vector<float> DistanceToMask(const std::uint8_t* mask, const ImageGeometry& grid, const ParallelFor& parallel);
+
 // Value below which `percentile` % of the values lie (a 4096-bin histogram over [0, max]).
 double RobustMaximum(const float* values, std::int64_t n, double percentile, const ParallelFor& parallel);
 

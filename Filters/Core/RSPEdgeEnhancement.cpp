@@ -768,7 +768,6 @@ std::vector<std::int64_t> FinalContour(
     return contour;
   }
   const std::array<int, 3> a = grid.Coordinates(A);
-  // The ray leaves A along the axis direction farthest from the nearest inside point.
   std::int64_t S = inside[0];
   double best = std::numeric_limits<double>::max();
   for (std::int64_t s : inside)
@@ -781,51 +780,40 @@ std::vector<std::int64_t> FinalContour(
       S = s;
     }
   }
+  // Closed paths through A that wind around S: a ray leaves S's lower-left corner along +x, every
+  // crossing of it flips a parity bit, and the cheapest path from (A, even) to (A, odd) is the
+  // cheapest closed path through A around S (the thesis blocks one edge A-B next to A, which also
+  // admits a 3-edge loop around no pixel).
   const std::array<int, 3> sc = grid.Coordinates(S);
-  const int dx = a[0] - sc[0], dy = a[1] - sc[1];
-  const int rayAxis = std::abs(dx) >= std::abs(dy) ? 0 : 1;
-  const int raySign = (rayAxis == 0 ? dx : dy) >= 0 ? 1 : -1;
-  const int across = 1 - rayAxis;
-  // B: the brighter neighbour of A across the ray's axis.
-  std::int64_t B = -1;
-  for (int d = 2 * across; d < 2 * across + 2; ++d)
-  {
-    if (grid.Inside(a, d) && (B < 0 || ec[A + grid.Offset[d]] > ec[B]))
-    {
-      B = A + grid.Offset[d];
-    }
-  }
-  const std::array<int, 3> b = grid.Coordinates(B);
-  const auto blocked = [&](const std::array<int, 3>& u, const std::array<int, 3>& v) {
-    if (u[rayAxis] != v[rayAxis])
-    {
-      return false;
-    }
-    const bool pair = (u[across] == a[across] && v[across] == b[across]) || (u[across] == b[across] && v[across] == a[across]);
-    return pair && (u[rayAxis] - a[rayAxis]) * raySign >= 0;
+  const auto crosses = [&](const std::array<int, 3>& u, int d) {
+    // Only moves along y between rows sc[1] - 1 and sc[1], at x >= sc[0], cross the ray.
+    return d / 2 == 1 && u[0] >= sc[0] && ((d == 2 && u[1] == sc[1] - 1) || (d == 3 && u[1] == sc[1]));
   };
-  std::vector<double> cost(static_cast<std::size_t>(n)), dist(static_cast<std::size_t>(n), std::numeric_limits<double>::infinity());
+  std::vector<double> cost(static_cast<std::size_t>(n));
   for (std::int64_t i = 0; i < n; ++i)
   {
     cost[i] = ec[i] > 0.f ? 1.0 / ec[i] : gapCost;
   }
-  std::vector<std::int8_t> parent(static_cast<std::size_t>(n), -1);
+  std::vector<double> dist(static_cast<std::size_t>(2 * n), std::numeric_limits<double>::infinity());
+  std::vector<std::int8_t> parent(static_cast<std::size_t>(2 * n), -1);
   MinHeap heap;
-  dist[A] = 0.0;
-  heap.emplace(0.0, A);
+  dist[2 * A] = 0.0;
+  heap.emplace(0.0, 2 * A);
+  const std::int64_t goal = 2 * A + 1;
   while (!heap.empty())
   {
     const HeapEntry top = heap.top();
     heap.pop();
-    const std::int64_t v = top.second;
-    if (top.first != dist[v])
+    const std::int64_t state = top.second;
+    if (top.first != dist[state])
     {
       continue;
     }
-    if (v == B)
+    if (state == goal)
     {
       break;
     }
+    const std::int64_t v = state / 2;
     const std::array<int, 3> c = grid.Coordinates(v);
     for (int d = 0; d < grid.Directions; ++d)
     {
@@ -834,33 +822,40 @@ std::vector<std::int64_t> FinalContour(
         continue;
       }
       const std::int64_t q = v + grid.Offset[d];
-      if (blocked(c, grid.Coordinates(q)))
-      {
-        continue;
-      }
+      const std::int64_t next = 2 * q + ((state & 1) ^ (crosses(c, d) ? 1 : 0));
       const double nd = top.first + 0.5 * (cost[v] + cost[q]);
-      if (nd < dist[q])
+      if (nd < dist[next])
       {
-        dist[q] = nd;
-        parent[q] = static_cast<std::int8_t>(d);
-        heap.emplace(nd, q);
+        dist[next] = nd;
+        parent[next] = static_cast<std::int8_t>(d);
+        heap.emplace(nd, next);
       }
     }
   }
-  if (!std::isfinite(dist[B]))
+  if (!std::isfinite(dist[goal]))
   {
     return contour;
   }
-  for (std::int64_t v = B;; v -= grid.Offset[parent[v]])
+  // Back from (A, odd) to (A, even); the parity before a step is recovered from the step itself.
+  for (std::int64_t state = goal; state != 2 * A;)
   {
+    const std::int64_t v = state / 2;
     contour.push_back(v);
-    if (v == A)
-    {
-      break;
-    }
+    const int d = parent[state];
+    const std::int64_t u = v - grid.Offset[d];
+    state = 2 * u + ((state & 1) ^ (crosses(grid.Coordinates(u), d) ? 1 : 0));
   }
   std::reverse(contour.begin(), contour.end());
-  return contour;
+  // A far from the ridge gives a lasso: a tail out to A and back along the same voxels. The
+  // contour is the loop: strip the tail (the voxels before and after its tip coincide).
+  std::size_t first = 0, last = contour.size(); // the cycle is contour[first, last), its tip last - 1
+  while (last - first >= 3 && contour[first] == contour[last - 2])
+  {
+    ++first;
+    --last;
+  }
+  return std::vector<std::int64_t>(contour.begin() + static_cast<std::ptrdiff_t>(first),
+    contour.begin() + static_cast<std::ptrdiff_t>(last));
 }
 
 std::vector<std::uint8_t> FillContour(const std::vector<std::int64_t>& contour, const ImageGeometry& g)

@@ -86,10 +86,10 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& grid, cons
   const std::vector<std::int64_t>& backgroundSeeds, const RSPParameters& p, const ParallelFor& parallel,
   const ProgressFunction& progress);
 
-// The 2D final contour (thesis 5.3) on an EC image: the brightest voxel A, a ray from A away from
-// the nearest of `inside` to the image border, and the cheapest path (cost 1/EC per voxel, GapCost
-// where EC = 0) from A around to its neighbour B across the ray; the ray may not be crossed, so the
-// closed path encloses that inside point. Empty when the image is not 2D or EC is all zero.
+// The 2D final contour (thesis 5.3) on an EC image: the cheapest closed path (cost 1/EC per voxel,
+// GapCost where EC = 0) through the brightest voxel A that winds around the nearest of `inside`
+// (the object seeds), without the tail out to A when A lies off the loop. Voxel indices in order;
+// each is a 4-neighbour of the next and the last of the first; no voxel twice. Empty when the image is not 2D or EC is all zero.
 std::vector<std::int64_t> FinalContour(const std::vector<float>& ec, const ImageGeometry& grid,
   const std::vector<std::int64_t>& inside, double gapCost);
 

@@ -5,6 +5,7 @@
 #include "vtkDelaunayImageMesh.h"
 #include "vtkFeatureNodes.h"
 #include "vtkImageMeshSmoothing.h"
+#include "vtkRSPEdgeEnhancement.h"
 #include "vtkSuperVoxelCut.h"
 #include "vtkVoxelCut.h"
 
@@ -1136,4 +1137,129 @@ TEST(ImageMeshSmoothing, ConstantImage)
   mesh->SetInputData(1, image);
   mesh->Update();
   Smoothing(mesh->GetOutput(), image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectSmoothed(run, out, image); });
+}
+
+//------------------------------------------------------------------------------------------------
+// RSP Edge Enhancement: images and seeds.
+namespace
+{
+template <typename Check>
+void RSP(vtkImageData* image, vtkPointSet* object, vtkPointSet* background, const Check& check,
+  const std::function<void(vtkRSPEdgeEnhancement*)>& set = nullptr)
+{
+  Run<vtkRSPEdgeEnhancement> rsp;
+  rsp->SetInputData(0, image);
+  if (object)
+    rsp->SetInputData(1, object);
+  if (background)
+    rsp->SetInputData(2, background);
+  if (set)
+    set(rsp.F);
+  rsp.Update();
+  check(rsp, vtkImageData::SafeDownCast(rsp->GetOutputDataObject(0)));
+}
+
+void ExpectGoodRSP(Run<vtkRSPEdgeEnhancement>& run, vtkImageData* out, vtkImageData* image)
+{
+  ASSERT_TRUE(run.Log->Errors.empty()) << run.Log->All();
+  vtkDataArray* ec = out->GetPointData()->GetArray("EdgeConfidence");
+  ASSERT_NE(ec, nullptr);
+  EXPECT_EQ(ec->GetNumberOfTuples(), image->GetNumberOfPoints());
+  EXPECT_NE(out->GetPointData()->GetArray("EdgeMap"), nullptr);
+  double range[2];
+  ec->GetRange(range);
+  EXPECT_GT(range[1], 0.0);
+  for (int a = 0; a < 3; ++a)
+  {
+    EXPECT_DOUBLE_EQ(out->GetSpacing()[a], image->GetSpacing()[a]);
+    EXPECT_DOUBLE_EQ(out->GetOrigin()[a], image->GetOrigin()[a]);
+  }
+}
+} // namespace
+
+TEST(RSPEdgeEnhancement, Disc)
+{
+  auto image = Disc();
+  RSP(image, ObjectSeeds(image), BackgroundSeeds(image), [&](auto& run, vtkImageData* out) {
+    ExpectGoodRSP(run, out, image);
+    vtkPolyData* contour = vtkPolyData::SafeDownCast(run->GetOutputDataObject(1));
+    EXPECT_GT(contour->GetNumberOfPoints(), 8);
+  });
+}
+TEST(RSPEdgeEnhancement, BallWithMirroredSpacing)
+{
+  auto image = Ball();
+  image->SetSpacing(-1.0, 1.0, 1.0);
+  RSP(image, ObjectSeeds(image), BackgroundSeeds(image), [&](auto& run, vtkImageData* out) { ExpectGoodRSP(run, out, image); });
+}
+TEST(RSPEdgeEnhancement, BallOnACoarserPathGrid)
+{
+  auto image = Ball();
+  RSP(image, ObjectSeeds(image), BackgroundSeeds(image),
+    [&](auto& run, vtkImageData* out) {
+      ExpectGoodRSP(run, out, image);
+      EXPECT_GE(out->GetFieldData()->GetArray("PathGridFactor")->GetTuple1(0), 2);
+    },
+    [](vtkRSPEdgeEnhancement* f) { f->SetMaximumPathVoxels(4000); });
+}
+TEST(RSPEdgeEnhancement, NoSeeds)
+{
+  auto image = Disc();
+  RSP(image, nullptr, BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "connections", out); });
+}
+TEST(RSPEdgeEnhancement, EmptySeeds)
+{
+  auto image = Disc();
+  RSP(image, Points({}), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "object", out); });
+}
+TEST(RSPEdgeEnhancement, OneClassOnly)
+{
+  auto image = Disc();
+  RSP(image, ObjectSeeds(image), ObjectSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "both", out); });
+}
+TEST(RSPEdgeEnhancement, SeedsOutside)
+{
+  auto image = Disc();
+  RSP(image, Points({ { { -40, 0, 0 } } }), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "outside", out); });
+}
+TEST(RSPEdgeEnhancement, ConstantImage)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int, int, int) { return 3.0; });
+  RSP(image, Points({ World(image, 20, 20, 0) }), Points({ World(image, 2, 2, 0) }),
+    [](auto& run, vtkImageData* out) { ExpectError(run, "constant", out); });
+}
+TEST(RSPEdgeEnhancement, OneVoxelImage)
+{
+  auto image = Image({ { 1, 1, 1 } }, [](int, int, int) { return 3.0; });
+  RSP(image, Points({ World(image, 0, 0, 0) }), Points({ World(image, 0, 0, 0) }),
+    [](auto& run, vtkImageData* out) { ExpectError(run, "at least 2", out); });
+}
+TEST(RSPEdgeEnhancement, NaNImage)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int i, int, int) { return i == 4 ? NaN : i; });
+  RSP(image, Points({ World(image, 20, 20, 0) }), Points({ World(image, 2, 2, 0) }),
+    [](auto& run, vtkImageData* out) { ExpectError(run, "NaN", out); });
+}
+TEST(RSPEdgeEnhancement, NoSources)
+{
+  auto image = Disc();
+  RSP(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "sources", out); },
+    [](vtkRSPEdgeEnhancement* f) { f->SetNumberOfSources(0); });
+}
+TEST(RSPEdgeEnhancement, EdgeThresholdAboveOne)
+{
+  auto image = Disc();
+  RSP(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "EdgeThreshold", out); },
+    [](vtkRSPEdgeEnhancement* f) { f->SetEdgeThreshold(2.0); });
+}
+TEST(RSPEdgeEnhancement, FeedsSeedAwareFeatureNodes)
+{
+  auto image = Disc();
+  vtkNew<vtkRSPEdgeEnhancement> rsp;
+  rsp->SetInputData(0, image);
+  rsp->SetInputData(1, ObjectSeeds(image));
+  rsp->SetInputData(2, BackgroundSeeds(image));
+  rsp->Update();
+  FeatureNodes(image, [&](auto& run, vtkPolyData* out) { ExpectNodesInside(run, out, image, 8); }, nullptr,
+    vtkImageData::SafeDownCast(rsp->GetOutputDataObject(0)));
 }

@@ -3,6 +3,7 @@
 #include "vtkDelaunayImageMesh.h"
 #include "vtkImageMeshSmoothing.h"
 #include "vtkFeatureNodes.h"
+#include "vtkRSPEdgeEnhancement.h"
 #include "vtkSuperVoxelCut.h"
 #include "vtkVoxelCut.h"
 
@@ -41,6 +42,13 @@ int main(int argc, char* argv[])
     GETTER(vtkFeatureNodes, Halftoning), GETTER(vtkFeatureNodes, HalftoneThreshold),
     GETTER(vtkFeatureNodes, HalftoneGamma), GETTER(vtkFeatureNodes, ExclusionWindow),
     GETTER(vtkFeatureNodes, UniformSpacing), GETTER(vtkFeatureNodes, BoundarySpacing),
+    GETTER(vtkFeatureNodes, SeedAware), GETTER(vtkFeatureNodes, EdgeGateRadius),
+    GETTER(vtkFeatureNodes, CoarseningLevels),
+    GETTER(vtkRSPEdgeEnhancement, GradientScale), GETTER(vtkRSPEdgeEnhancement, GradientSigma),
+    GETTER(vtkRSPEdgeEnhancement, NumberOfSources), GETTER(vtkRSPEdgeEnhancement, NumberOfSinks),
+    GETTER(vtkRSPEdgeEnhancement, RandomSeed), GETTER(vtkRSPEdgeEnhancement, SamplingThreshold),
+    GETTER(vtkRSPEdgeEnhancement, EdgeThreshold), GETTER(vtkRSPEdgeEnhancement, PathMargin),
+    GETTER(vtkRSPEdgeEnhancement, MaximumPathVoxels), GETTER(vtkRSPEdgeEnhancement, GapCost),
     GETTER(vtkDelaunayImageMesh, Backend), GETTER(vtkDelaunayImageMesh, QualityRefinement),
     GETTER(vtkDelaunayImageMesh, RadiusEdgeRatio), GETTER(vtkDelaunayImageMesh, MinDihedralAngle),
     GETTER(vtkImageMeshSmoothing, Method), GETTER(vtkImageMeshSmoothing, Iterations),
@@ -59,7 +67,8 @@ int main(int argc, char* argv[])
   };
   int failures = 0, checked = 0;
   std::set<std::string> seen;
-  for (const char* file : { "FeatureNodes.xml", "DelaunayImageMesh.xml", "ImageMeshSmoothing.xml", "SuperVoxelCut.xml" })
+  for (const char* file : { "FeatureNodes.xml", "DelaunayImageMesh.xml", "ImageMeshSmoothing.xml", "RSPEdgeEnhancement.xml",
+         "SuperVoxelCut.xml" })
   {
     vtkNew<vtkXMLDataParser> parser;
     const std::string path = std::string(argv[1]) + "/" + file;

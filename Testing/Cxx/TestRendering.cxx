@@ -3,6 +3,7 @@
 #include "vtkDelaunayImageMesh.h"
 #include "vtkImageMeshSmoothing.h"
 #include "vtkFeatureNodes.h"
+#include "vtkRSPEdgeEnhancement.h"
 #include "vtkSuperVoxelCut.h"
 
 #include "vtkActor.h"
@@ -10,8 +11,10 @@
 #include "vtkCamera.h"
 #include "vtkCellArray.h"
 #include "vtkDataSetMapper.h"
+#include "vtkFieldData.h"
 #include "vtkImageActor.h"
 #include "vtkImageData.h"
+#include "vtkImageMapToColors.h"
 #include "vtkImageMapper3D.h"
 #include "vtkImageProperty.h"
 #include "vtkMetaImageReader.h"
@@ -28,6 +31,7 @@
 #include "vtkTableBasedClipDataSet.h"
 #include "vtkUnstructuredGrid.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
@@ -57,6 +61,49 @@ vtkSmartPointer<vtkPolyData> ReadSeeds(const std::string& file)
   return pd;
 }
 
+// One point array of an image through a lookup table (values above the range black: the marching
+// maps are infinite beyond their thresholds).
+void AddColouredImage(vtkRenderer* ren, vtkImageData* image, const char* array, double lo, double hi, bool log)
+{
+  vtkNew<vtkLookupTable> table;
+  table->SetTableRange(log ? std::max(1.0, lo) : lo, hi);
+  if (log)
+  {
+    table->SetScaleToLog10();
+  }
+  table->SetHueRange(0.7, 0.0);
+  table->SetBelowRangeColor(0, 0, 0, 1);
+  table->SetAboveRangeColor(0, 0, 0, 1);
+  table->UseBelowRangeColorOn();
+  table->UseAboveRangeColorOn();
+  table->Build();
+  vtkNew<vtkImageData> copy;
+  copy->ShallowCopy(image);
+  copy->GetPointData()->SetActiveScalars(array);
+  vtkNew<vtkImageMapToColors> colours;
+  colours->SetInputData(copy);
+  colours->SetLookupTable(table);
+  colours->Update();
+  vtkNew<vtkImageActor> actor;
+  actor->GetMapper()->SetInputConnection(colours->GetOutputPort());
+  actor->SetPosition(0, 0, -0.5);
+  ren->AddViewProp(actor);
+}
+
+void AddPoints(vtkRenderer* ren, vtkPolyData* points, double r, double g, double b, double size)
+{
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(points);
+  mapper->ScalarVisibilityOff();
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetColor(r, g, b);
+  actor->GetProperty()->SetPointSize(size);
+  actor->GetProperty()->SetLineWidth(2);
+  actor->SetPosition(0, 0, 1);
+  ren->AddActor(actor);
+}
+
 void AddImage(vtkRenderer* ren, vtkImageData* image, double window, double level)
 {
   vtkNew<vtkImageActor> actor;
@@ -77,7 +124,9 @@ int main(int argc, char* argv[])
   }
   const std::string scene = argv[1], data = argv[2];
   const bool liver = scene.rfind("Liver", 0) == 0;
-  const std::string caseDir = data + (liver ? "/liver-ct-totalseg/" : "/nuclei-dsb2018/");
+  // DataDir is the bundled data, or one case folder (to draw a shared case by hand).
+  const bool oneCase = std::ifstream(data + "/image.mha").good();
+  const std::string caseDir = oneCase ? data + "/" : data + (liver ? "/liver-ct-totalseg/" : "/nuclei-dsb2018/");
 
   vtkNew<vtkMetaImageReader> reader;
   reader->SetFileName((caseDir + "image.mha").c_str());
@@ -243,16 +292,73 @@ int main(int argc, char* argv[])
     }
     ren->ResetCameraClippingRange();
   }
+  else if (scene == "NucleiRSP")
+  {
+    // The thesis's figure set: object marching map, background marching map with the sources (red)
+    // and sinks (cyan), the edge confidence (black: no path), the final contour (red) on the image.
+    vtkNew<vtkRSPEdgeEnhancement> rsp;
+    rsp->SetInputConnection(0, reader->GetOutputPort());
+    rsp->SetInputData(1, ReadSeeds(caseDir + "seeds_object.csv"));
+    rsp->SetInputData(2, ReadSeeds(caseDir + "seeds_background.csv"));
+    rsp->Update();
+    vtkImageData* ec = vtkImageData::SafeDownCast(rsp->GetOutputDataObject(0));
+    vtkPolyData* samples = vtkPolyData::SafeDownCast(rsp->GetOutputDataObject(2));
+    const double T0 = ec->GetFieldData()->GetArray("ObjectThreshold")->GetTuple1(0);
+    const double T1 = ec->GetFieldData()->GetArray("BackgroundThreshold")->GetTuple1(0);
+    const double paths = ec->GetFieldData()->GetArray("Paths")->GetTuple1(0);
+    vtkNew<vtkPolyData> sources, sinks;
+    for (int role = 0; role < 2; ++role)
+    {
+      vtkNew<vtkPoints> pts;
+      vtkNew<vtkCellArray> verts;
+      vtkDataArray* roles = samples->GetPointData()->GetArray("SampleRole");
+      for (vtkIdType i = 0; i < samples->GetNumberOfPoints(); ++i)
+      {
+        if (roles->GetTuple1(i) == role)
+        {
+          const vtkIdType id = pts->InsertNextPoint(samples->GetPoint(i));
+          verts->InsertNextCell(1, &id);
+        }
+      }
+      vtkPolyData* pd = role == 0 ? sources.Get() : sinks.Get();
+      pd->SetPoints(pts);
+      pd->SetVerts(verts);
+    }
+    win->SetSize(1200, 300);
+    vtkRenderer* panels[4] = { ren, nullptr, nullptr, nullptr };
+    for (int i = 0; i < 4; ++i)
+    {
+      if (i > 0)
+      {
+        panels[i] = vtkRenderer::New();
+        panels[i]->SetBackground(0.1, 0.1, 0.15);
+        panels[i]->SetActiveCamera(ren->GetActiveCamera());
+        win->AddRenderer(panels[i]);
+        panels[i]->Delete(); // the window holds it
+      }
+      panels[i]->SetViewport(0.25 * i, 0, 0.25 * (i + 1), 1);
+    }
+    AddColouredImage(panels[0], ec, "ObjectDistance", 0, T0, false);
+    AddColouredImage(panels[1], ec, "BackgroundDistance", 0, T1, false);
+    AddPoints(panels[1], sources, 1, 0.2, 0.2, 4);
+    AddPoints(panels[1], sinks, 0.2, 1, 1, 4);
+    AddColouredImage(panels[2], ec, "EdgeConfidence", 0.5, paths / 20, false);
+    AddImage(panels[3], image, 120, 60);
+    AddPoints(panels[3], vtkPolyData::SafeDownCast(rsp->GetOutputDataObject(1)), 1, 0.2, 0.2, 2);
+    AddPoints(panels[3], ReadSeeds(caseDir + "seeds_object.csv"), 1, 1, 0.2, 6);
+    ren->ResetCamera();
+    ren->GetActiveCamera()->Zoom(1.3);
+  }
   else
   {
     std::cerr << "unknown scene " << scene << "\n";
     return 1;
   }
-  if (scene != "NucleiSmoothing" && scene != "LiverSmoothing")
+  if (scene != "NucleiSmoothing" && scene != "LiverSmoothing" && scene != "NucleiRSP")
   {
     ren->ResetCamera();
   }
-  if (scene.rfind("Nuclei", 0) == 0 && scene != "NucleiSmoothing")
+  if (scene.rfind("Nuclei", 0) == 0 && scene != "NucleiSmoothing" && scene != "NucleiRSP")
   {
     ren->GetActiveCamera()->Zoom(1.4);
   }
