@@ -34,4 +34,19 @@ for r in rows:
     ft.check(v["components"] >= 1, "%s: object components reported" % r["case"])
     ft.check(v["min_angle_smoothed"] > v["min_angle_delaunay"] and v["smoothing_s"] > 0,
              "%s: the pipeline smooths the mesh: min angle %.2f -> %.2f" % (r["case"], v["min_angle_delaunay"], v["min_angle_smoothed"]))
+
+# Stage 5's benchmark: EC ratio and the seed-aware mesh against Canny's, on the bundled cases.
+script = os.path.join(ft.fm.ROOT, "scripts", "benchmark_rsp.py")
+run = subprocess.run([shutil.which("pvpython"), script, "--no-slic", "--out", out + "_rsp"], env=env, capture_output=True,
+                     text=True)
+print(run.stdout[-2000:])
+ft.check(run.returncode == 0, "benchmark_rsp.py exits 0 (stderr: %s)" % run.stderr[-500:])
+rows = list(csv.DictReader(open(out + "_rsp.csv"))) if os.path.isfile(out + "_rsp.csv") else []
+ft.check(sorted(r["case"] for r in rows) == ["liver-ct-totalseg", "nuclei-dsb2018"], "benchmark_rsp: both bundled cases")
+for r in rows:
+    v = {k: float(x) for k, x in r.items() if k != "case"}
+    ft.check(v["ec_ratio"] > 1.0 and v["rsp_s"] > 0, "%s: EC ratio %.2f > 1" % (r["case"], v["ec_ratio"]))
+    for mesh in ("canny", "rsp"):
+        ft.check(0 < v["dice_" + mesh] <= v["oracle_" + mesh] + 1e-9 <= 1.0 + 1e-9,
+                 "%s: %s mesh: Dice %.3f <= oracle %.3f" % (r["case"], mesh, v["dice_" + mesh], v["oracle_" + mesh]))
 print("all benchmark checks passed")

@@ -36,4 +36,18 @@ ft.check(report.get("smoothing") is True and "image_mesh_smoothing" in report.ge
 ft.check(angles.get("final", {}).get("min", 0) > angles.get("delaunay", {}).get("min", 90),
          "quality before / after in the report: min angle %s -> %s" % (angles.get("delaunay", {}).get("min"), angles.get("final", {}).get("min")))
 ft.check("mesh quality" in run.stdout and "smoothed min" in run.stdout, "the script prints quality before / after")
+
+# --rsp: RSP Edge Enhancement feeds Feature Nodes, on the liver (3D).
+d = ft.case_dir("liver-ct-totalseg")
+run = subprocess.run([shutil.which("pvpython"), script, os.path.join(d, "image.mha"),
+                      "--object-seeds", os.path.join(d, "seeds_object.csv"),
+                      "--background-seeds", os.path.join(d, "seeds_background.csv"),
+                      "--truth", os.path.join(d, "truth.mha"), "--out", out, "--rsp"], capture_output=True, text=True)
+ft.check(run.returncode == 0, "--rsp: the script exits 0 (stderr: %s)" % run.stderr[-800:])
+base = os.path.join(out, "liver-ct-totalseg")
+ft.check(os.path.isfile(base + "_edge_confidence.vti"), "--rsp: wrote the edge-confidence image")
+report = json.load(open(base + "_report.json")) if os.path.isfile(base + "_report.json") else {}
+ft.check(report.get("rsp") is True and "rsp_edge_enhancement" in report.get("seconds", {}),
+         "--rsp: the report says RSP ran first (timed)")
+ft.check(report.get("dice", 0) > 0.8, "--rsp: liver Dice %s > 0.8" % report.get("dice"))
 print("all main-job checks passed")
