@@ -247,6 +247,13 @@ std::vector<std::array<double, 3>> PointsOf(vtkPointSet* points)
   return p;
 }
 
+bool ObjectAndBackgroundVoxels(vtkPointSet* object, vtkPointSet* background, const ImageGeometry& geometry,
+  std::vector<std::int64_t>& objectVoxels, std::vector<std::int64_t>& backgroundVoxels, std::string& error)
+{
+  return SeedVoxels(PointsOf(object), geometry, "object", objectVoxels, error) &&
+    SeedVoxels(PointsOf(background), geometry, "background", backgroundVoxels, error);
+}
+
 bool ToSimplexMesh(vtkUnstructuredGrid* grid, const ImageGeometry& geometry, SimplexMesh& mesh, std::string& error)
 {
   const vtkIdType nCells = grid ? grid->GetNumberOfCells() : 0;

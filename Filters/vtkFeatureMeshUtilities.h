@@ -114,6 +114,11 @@ void SetImageFrame(vtkImageData* image, const ImageGeometry& geometry);
 // The points of a point set, world coordinates (empty for null).
 std::vector<std::array<double, 3>> PointsOf(vtkPointSet* points);
 
+// The voxels of the object and background seed point sets (SeedVoxels for each); false with the
+// sentence of the first that fails.
+bool ObjectAndBackgroundVoxels(vtkPointSet* object, vtkPointSet* background, const ImageGeometry& geometry,
+  std::vector<std::int64_t>& objectVoxels, std::vector<std::int64_t>& backgroundVoxels, std::string& error);
+
 // A triangle (2D) / tetrahedral (3D) unstructured grid as a SimplexMesh on `geometry`'s index
 // space, every element positively oriented there; false with a sentence for mixed or other cell
 // types, or a cell type that does not match the image's dimension.

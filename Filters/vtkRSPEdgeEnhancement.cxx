@@ -128,8 +128,7 @@ int vtkRSPEdgeEnhancement::RequestData(vtkInformation*, vtkInformationVector** i
       return fail(error);
     }
     std::vector<std::int64_t> objectVoxels, backgroundVoxels;
-    if (!SeedVoxels(PointsOf(objectSeeds), geometry, "object", objectVoxels, error) ||
-      !SeedVoxels(PointsOf(backgroundSeeds), geometry, "background", backgroundVoxels, error))
+    if (!ObjectAndBackgroundVoxels(objectSeeds, backgroundSeeds, geometry, objectVoxels, backgroundVoxels, error))
     {
       return fail(error);
     }

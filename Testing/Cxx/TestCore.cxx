@@ -1328,6 +1328,17 @@ std::vector<float> DiskImage(const ImageGeometry& g, double cx, double cy, doubl
       f[g.Index(i, j, 0)] = (std::hypot(i - cx, j - cy) <= r ? 200.f : 40.f) + static_cast<float>((i * 7 + j * 13) % 5);
   return f;
 }
+
+// The stage on a 96^2 disk of radius 20 with two object and four background seeds.
+RSPResult DiskRSP(const RSPParameters& p, const ParallelFor& parallel = SerialFor())
+{
+  ImageGeometry g = Grid2(96, 96);
+  const std::vector<float> f = DiskImage(g, 48, 48, 20);
+  const std::vector<std::int64_t> object{ g.Index(48, 48, 0), g.Index(40, 52, 0) };
+  const std::vector<std::int64_t> background{ g.Index(20, 20, 0), g.Index(80, 30, 0), g.Index(48, 80, 0),
+    g.Index(15, 60, 0) };
+  return RSPEdgeEnhancement(f.data(), g, object, background, p, parallel, NoProgress());
+}
 } // namespace
 
 TEST(RSPEdgeEnhancement, FastMarchingOnAConstantImageIsEuclidean)
@@ -1397,12 +1408,8 @@ TEST(RSPEdgeEnhancement, PathsCrossATwoPlateauImageAtTheStep)
 TEST(RSPEdgeEnhancement, SourcesFallInsideTheDiskAndSinksOutside)
 {
   ImageGeometry g = Grid2(96, 96);
-  const std::vector<float> f = DiskImage(g, 48, 48, 20);
-  const std::vector<std::int64_t> object{ g.Index(48, 48, 0), g.Index(40, 52, 0) };
-  const std::vector<std::int64_t> background{ g.Index(20, 20, 0), g.Index(80, 30, 0), g.Index(48, 80, 0),
-    g.Index(15, 60, 0) };
   RSPParameters p;
-  const RSPResult r = RSPEdgeEnhancement(f.data(), g, object, background, p, SerialFor(), NoProgress());
+  const RSPResult r = DiskRSP(p);
   ASSERT_TRUE(r.Error.empty()) << r.Error;
   ASSERT_EQ(r.SourceVoxels.size(), 50u);
   ASSERT_EQ(r.SinkVoxels.size(), 100u);
@@ -1427,12 +1434,8 @@ TEST(RSPEdgeEnhancement, SourcesFallInsideTheDiskAndSinksOutside)
 TEST(RSPEdgeEnhancement, EdgeConfidenceFollowsTheDiskAndTheContourClosesAroundIt)
 {
   ImageGeometry g = Grid2(96, 96);
-  const std::vector<float> f = DiskImage(g, 48, 48, 20);
-  const std::vector<std::int64_t> object{ g.Index(48, 48, 0), g.Index(40, 52, 0) };
-  const std::vector<std::int64_t> background{ g.Index(20, 20, 0), g.Index(80, 30, 0), g.Index(48, 80, 0),
-    g.Index(15, 60, 0) };
   RSPParameters p;
-  const RSPResult r = RSPEdgeEnhancement(f.data(), g, object, background, p, SerialFor(), NoProgress());
+  const RSPResult r = DiskRSP(p);
   ASSERT_TRUE(r.Error.empty()) << r.Error;
   double nearSum = 0, farSum = 0;
   int nearCount = 0, farCount = 0;
@@ -1464,11 +1467,11 @@ TEST(RSPEdgeEnhancement, EdgeConfidenceFollowsTheDiskAndTheContourClosesAroundIt
   }
   EXPECT_GT(2.0 * both / (region + disk), 0.9);
   // Split-invariant: the same EC for any split of the sources.
-  const RSPResult c = RSPEdgeEnhancement(f.data(), g, object, background, p, Chunked, NoProgress());
+  const RSPResult c = DiskRSP(p, Chunked);
   EXPECT_EQ(c.EdgeConfidence, r.EdgeConfidence);
   EXPECT_EQ(c.Contour, r.Contour);
   p.RandomSeed = 3;
-  const RSPResult other = RSPEdgeEnhancement(f.data(), g, object, background, p, SerialFor(), NoProgress());
+  const RSPResult other = DiskRSP(p);
   EXPECT_NE(other.SourceVoxels, r.SourceVoxels);
 }
 
