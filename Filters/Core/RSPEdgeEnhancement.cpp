@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -12,6 +14,7 @@
 #include <mutex>
 #include <queue>
 #include <random>
+#include <thread>
 #include <unordered_set>
 
 namespace featuremesh
@@ -137,7 +140,7 @@ std::string ValidateParameters(const RSPParameters& p)
 }
 
 std::vector<float> FastMarching(const float* slowness, const ImageGeometry& g, const std::vector<std::int64_t>& seeds,
-  double stopAt, const std::vector<std::int64_t>* medianOf, double* median)
+  double stopAt, const std::vector<std::int64_t>* medianOf, double* median, const ProgressFunction& progress)
 {
   const std::int64_t n = g.Size();
   const Grid grid(g.Dims);
@@ -153,6 +156,7 @@ std::vector<float> FastMarching(const float* slowness, const ImageGeometry& g, c
   }
   const std::size_t needed = (targets.size() + 1) / 2;
   std::size_t reached = 0;
+  std::int64_t settled = 0;
   MinHeap heap;
   for (std::int64_t s : seeds)
   {
@@ -173,6 +177,10 @@ std::vector<float> FastMarching(const float* slowness, const ImageGeometry& g, c
       break;
     }
     known[v] = 1;
+    if ((++settled & 0xFFFF) == 0 && !progress(static_cast<double>(settled) / static_cast<double>(n)))
+    {
+      return {};
+    }
     if (reached < needed && std::binary_search(targets.begin(), targets.end(), v) && ++reached == needed)
     {
       *median = top.first;
@@ -314,7 +322,7 @@ struct Workspace
 // the voxels on it. `weight` holds, per voxel, one weight per axis for the edge to the next voxel
 // along it (0: no edge, where the box ends).
 void PathsFromSource(std::uint32_t source, const std::vector<std::uint32_t>& sinks, const std::vector<std::uint8_t>& isSink,
-  const std::vector<std::uint16_t>& weight, const Grid& grid, Workspace& w)
+  const std::vector<std::uint16_t>& weight, const Grid& grid, Workspace& w, const std::atomic<bool>& cancel)
 {
   constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
   constexpr std::uint64_t farthest = (std::uint64_t(1) << 29) - 1;
@@ -326,7 +334,7 @@ void PathsFromSource(std::uint32_t source, const std::vector<std::uint32_t>& sin
   std::size_t settledSinks = 0;
   w.Label[source] = 7;
   w.Buckets[0].push_back(source);
-  for (std::uint64_t d = 0; queued > 0 && settledSinks < sinks.size(); ++d)
+  for (std::uint64_t d = 0; queued > 0 && settledSinks < sinks.size() && !cancel.load(std::memory_order_relaxed); ++d)
   {
     auto& bucket = w.Buckets[d & mask];
     while (!bucket.empty())
@@ -408,18 +416,45 @@ RSPResult OnCoarserGrid(const float* image, const ImageGeometry& g, const std::v
   };
   std::vector<float> coarse(static_cast<std::size_t>(c.Size()), 0.f);
   {
-    std::vector<double> sum(static_cast<std::size_t>(c.Size()), 0.0);
-    std::vector<int> count(static_cast<std::size_t>(c.Size()), 0);
-    for (std::int64_t v = 0; v < g.Size(); ++v)
-    {
-      const std::int64_t b = block(v);
-      sum[b] += image[v];
-      ++count[b];
-    }
-    for (std::int64_t b = 0; b < c.Size(); ++b)
-    {
-      coarse[b] = static_cast<float>(sum[b] / count[b]);
-    }
+    // Coarse slab by coarse slab (independent sums), row by row without divisions.
+    parallel(c.Dims[2], 1, [&](std::int64_t c0, std::int64_t c1) {
+      std::vector<double> sum(static_cast<std::size_t>(c.SliceStride()));
+      std::vector<int> count(sum.size());
+      for (std::int64_t ck = c0; ck < c1; ++ck)
+      {
+        std::fill(sum.begin(), sum.end(), 0.0);
+        std::fill(count.begin(), count.end(), 0);
+        const int k0 = dim == 3 ? static_cast<int>(ck) * f : 0, k1 = dim == 3 ? std::min(g.Dims[2], k0 + f) : 1;
+        for (int k = k0; k < k1; ++k)
+        {
+          for (int j = 0; j < g.Dims[1]; ++j)
+          {
+            const float* row = image + g.Index(0, j, k);
+            const std::int64_t base = static_cast<std::int64_t>(j / f) * c.Dims[0];
+            for (int i = 0, ci = 0, left = f; i < g.Dims[0]; ++i)
+            {
+              sum[base + ci] += row[i];
+              ++count[base + ci];
+              if (--left == 0)
+              {
+                ++ci;
+                left = f;
+              }
+            }
+          }
+        }
+        for (std::int64_t b = 0; b < c.SliceStride(); ++b)
+        {
+          coarse[ck * c.SliceStride() + b] = static_cast<float>(sum[b] / count[b]);
+        }
+      }
+    });
+  }
+  if (!progress(0.03))
+  {
+    RSPResult aborted;
+    aborted.Aborted = true;
+    return aborted;
   }
   const auto toCoarse = [&](const std::vector<std::int64_t>& seeds) {
     std::vector<std::int64_t> out;
@@ -573,14 +608,20 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
   t0 = Clock::now();
   out.ObjectThreshold = p.SamplingThreshold;
   out.BackgroundThreshold = p.SamplingThreshold;
-  out.ObjectDistance = FastMarching(slowness.data(), g, objectSeeds, p.SamplingThreshold, &backgroundSeeds, &out.ObjectThreshold);
-  if (!progress(0.15))
+  out.ObjectDistance = FastMarching(slowness.data(), g, objectSeeds, p.SamplingThreshold, &backgroundSeeds,
+    &out.ObjectThreshold, SubProgress(progress, 0.05, 0.15));
+  if (out.ObjectDistance.empty() || !progress(0.15))
   {
     out.Aborted = true;
     return out;
   }
-  out.BackgroundDistance =
-    FastMarching(slowness.data(), g, backgroundSeeds, p.SamplingThreshold, &objectSeeds, &out.BackgroundThreshold);
+  out.BackgroundDistance = FastMarching(slowness.data(), g, backgroundSeeds, p.SamplingThreshold, &objectSeeds,
+    &out.BackgroundThreshold, SubProgress(progress, 0.15, 0.25));
+  if (out.BackgroundDistance.empty())
+  {
+    out.Aborted = true;
+    return out;
+  }
   out.StepSeconds.emplace_back("marching", SecondsSince(t0));
   std::vector<float>().swap(slowness);
   if (!progress(0.25))
@@ -705,14 +746,58 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
     idle.push_back(w);
   };
   const std::int64_t nSources = static_cast<std::int64_t>(out.SourceVoxels.size());
-  const bool go = BatchedFor(nSources, 1, parallel, SubProgress(progress, 0.3, 0.9), [&](std::int64_t s0, std::int64_t s1) {
-    Workspace* w = acquire();
-    for (std::int64_t s = s0; s < s1; ++s)
+  // The trees run on a worker thread (itself using `parallel`); this thread reports progress as
+  // sources finish, every 0.1 s at most, and on abort cancels the trees, which stop within a bucket.
+  std::atomic<bool> cancel{ false };
+  std::atomic<std::int64_t> done{ 0 };
+  std::mutex doneLock;
+  std::condition_variable doneSignal;
+  std::exception_ptr failure;
+  std::thread worker([&]() {
+    try
     {
-      PathsFromSource(static_cast<std::uint32_t>(box.Local(g, out.SourceVoxels[s])), sinks, isSink, weight, local, *w);
+      parallel(nSources, 1, [&](std::int64_t s0, std::int64_t s1) {
+        Workspace* w = acquire();
+        for (std::int64_t s = s0; s < s1 && !cancel; ++s)
+        {
+          PathsFromSource(static_cast<std::uint32_t>(box.Local(g, out.SourceVoxels[s])), sinks, isSink, weight, local, *w, cancel);
+          std::lock_guard<std::mutex> lock(doneLock);
+          ++done;
+          doneSignal.notify_all();
+        }
+        release(w);
+      });
     }
-    release(w);
+    catch (...)
+    {
+      failure = std::current_exception();
+    }
+    std::lock_guard<std::mutex> lock(doneLock);
+    done = nSources; // also after a failure or cancel: the waiting ends
+    doneSignal.notify_all();
   });
+  bool go = true;
+  {
+    std::unique_lock<std::mutex> lock(doneLock);
+    while (done < nSources)
+    {
+      doneSignal.wait_for(lock, std::chrono::milliseconds(100));
+      const double fraction = static_cast<double>(done) / static_cast<double>(nSources);
+      lock.unlock();
+      go = progress(0.3 + 0.6 * fraction);
+      lock.lock();
+      if (!go)
+      {
+        cancel = true;
+        break;
+      }
+    }
+  }
+  worker.join();
+  if (failure)
+  {
+    std::rethrow_exception(failure);
+  }
   if (!go)
   {
     out.Aborted = true;

@@ -71,9 +71,11 @@ std::string ValidateParameters(const RSPParameters& p);
 // index space with the spacing's aspect (unit = the smallest spacing). Marching stops once the front
 // passes `stopAt` (or, when `stopAt` <= 0, when every voxel is reached); voxels not reached are
 // +inf. With `median` not null and `stopAt` <= 0, marching stops once it passes the median of M over
-// `medianOf` (written to *median) instead.
+// `medianOf` (written to *median) instead. Empty when `progress` (asked every 65536 voxels, with
+// the fraction of the image reached) asks to abort.
 std::vector<float> FastMarching(const float* slowness, const ImageGeometry& grid, const std::vector<std::int64_t>& seeds,
-  double stopAt, const std::vector<std::int64_t>* medianOf = nullptr, double* median = nullptr);
+  double stopAt, const std::vector<std::int64_t>* medianOf = nullptr, double* median = nullptr,
+  const ProgressFunction& progress = NoProgress());
 
 // Rejection sampling (thesis 5.1.3): draws voxels uniformly among those with map <= T and keeps P
 // when map(P) <= V, V uniform in [0, T], until `count` distinct voxels are kept (fewer when the

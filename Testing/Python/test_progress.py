@@ -1,5 +1,5 @@
 """Progress and abort on the largest case (BraTS, 240x240x155): every filter reports progress at
-least every 0.5 s; an abort during the max-flow (or the smoothing's TetGen refinement) returns within
+least every 0.5 s; an abort during the max-flow (or the smoothing's TetGen refinement, or RSP's paths) returns within
 a second with an empty output; the aborted filter runs again on the next update and gives its full
 result."""
 import time
@@ -28,7 +28,8 @@ mesh = case.mesh(nodes)
 smoothed = case.smoothing(mesh)
 cut = case.super_voxel_cut(mesh)
 for name, proxy in (("Feature Nodes", nodes), ("Delaunay Image Mesh", mesh), ("Image Mesh Smoothing", smoothed),
-                    ("Super-Voxel Cut", cut), ("Voxel Cut", case.voxel_cut())):
+                    ("Super-Voxel Cut", cut), ("Voxel Cut", case.voxel_cut()), ("RSP Edge Enhancement", case.rsp()),
+                    ("RSP Edge Enhancement at full resolution", case.rsp(MaximumPathVoxels=0))):
     gap, events, seconds = watch(proxy)
     ft.check(gap <= MAX_GAP, "%s on BraTS: %d progress events over %.2f s, longest gap %.3f s (<= %.1f s)" % (name, events, seconds, gap, MAX_GAP))
 
@@ -80,3 +81,11 @@ ft.check(after is not None and after < 1.0, "Image Mesh Smoothing returns %.2f s
 ft.check(empty, "an aborted Image Mesh Smoothing has an empty output")
 sm.UpdatePipeline()
 ft.check(ft.fetch(sm).GetNumberOfCells() > ft.fetch(mesh).GetNumberOfCells(), "and runs again on the next update")
+
+# RSP Edge Enhancement at full resolution, aborted during its shortest paths.
+rsp = case.rsp(MaximumPathVoxels=0)
+after, empty = abort_after(rsp, 0.5)
+ft.check(after is not None and after < 1.0, "RSP Edge Enhancement returns %.2f s after an abort during the paths (< 1 s)" % (after or -1))
+ft.check(empty, "an aborted RSP Edge Enhancement has an empty output")
+rsp.UpdatePipeline()
+ft.check(ft.array(ft.fetch(rsp), "EdgeConfidence").max() > 0, "and runs again on the next update")
