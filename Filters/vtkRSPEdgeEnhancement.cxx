@@ -156,11 +156,15 @@ int vtkRSPEdgeEnhancement::RequestData(vtkInformation*, vtkInformationVector** i
     }
 
     SetImageFrame(output, geometry);
+    // Each copy of a BraTS-sized array takes ~0.05 s: progress between them.
     AddPointArray<vtkFloatArray>(output, names::EdgeConfidence, r.EdgeConfidence);
     output->GetPointData()->SetActiveScalars(names::EdgeConfidence);
+    this->UpdateProgress(0.96);
     AddPointArray<vtkUnsignedCharArray>(output, names::EdgeMap, r.EdgeMap);
     AddPointArray<vtkFloatArray>(output, names::ObjectDistance, r.ObjectDistance);
+    this->UpdateProgress(0.97);
     AddPointArray<vtkFloatArray>(output, names::BackgroundDistance, r.BackgroundDistance);
+    this->UpdateProgress(0.98);
     if (geometry.Is2D())
     {
       AddPointArray<vtkUnsignedCharArray>(output, names::ContourRegion, r.Region.empty() ? std::vector<std::uint8_t>(geometry.Size(), 0) : r.Region);

@@ -484,7 +484,7 @@ RSPResult OnCoarserGrid(const float* image, const ImageGeometry& g, const std::v
   q.SamplingThreshold = p.SamplingThreshold / f;
   q.PathMargin = (p.PathMargin + f - 1) / f;
   const double coarsening = SecondsSince(t0);
-  RSPResult r = RSPEdgeEnhancement(coarse.data(), c, object, background, q, parallel, progress);
+  RSPResult r = RSPEdgeEnhancement(coarse.data(), c, object, background, q, parallel, SubProgress(progress, 0.03, 0.9));
   if (!r.Error.empty() || r.Aborted)
   {
     return r;
@@ -524,6 +524,11 @@ RSPResult OnCoarserGrid(const float* image, const ImageGeometry& g, const std::v
     }
     return fine;
   };
+  if (!progress(0.95))
+  {
+    out.Aborted = true;
+    return out;
+  }
   out.SourceVoxels = toFine(r.SourceVoxels);
   out.SinkVoxels = toFine(r.SinkVoxels);
   if (g.Is2D())
@@ -533,6 +538,7 @@ RSPResult OnCoarserGrid(const float* image, const ImageGeometry& g, const std::v
   }
   out.StepSeconds.emplace_back("coarsening", coarsening + SecondsSince(t1));
   out.StepSeconds.insert(out.StepSeconds.end(), r.StepSeconds.begin(), r.StepSeconds.end());
+  progress(1.0);
   return out;
 }
 } // namespace
