@@ -170,10 +170,8 @@ int vtkRSPEdgeEnhancement::RequestData(vtkInformation*, vtkInformationVector** i
       AddPointArray<vtkUnsignedCharArray>(output, names::ContourRegion, r.Region.empty() ? std::vector<std::uint8_t>(geometry.Size(), 0) : r.Region);
     }
     const auto world = [&](std::int64_t v) {
-      const std::int64_t sz = geometry.SliceStride();
-      const std::array<double, 3> index{ { static_cast<double>((v % sz) % geometry.Dims[0]),
-        static_cast<double>((v % sz) / geometry.Dims[0]), static_cast<double>(v / sz) } };
-      return geometry.IndexToWorld(index);
+      const std::array<int, 3> c = geometry.Coordinates(v);
+      return geometry.IndexToWorld({ { static_cast<double>(c[0]), static_cast<double>(c[1]), static_cast<double>(c[2]) } });
     };
     if (!r.Contour.empty())
     {

@@ -37,6 +37,15 @@ struct ImageGeometry
     return std::fabs(Spacing[0] * Spacing[1]) * (Is2D() ? 1.0 : std::fabs(Spacing[2]));
   }
   std::int64_t SliceStride() const { return static_cast<std::int64_t>(Dims[0]) * Dims[1]; }
+  // The (i, j, k) of a voxel index: the inverse of Index.
+  std::array<int, 3> Coordinates(std::int64_t v) const
+  {
+    const std::int64_t slice = SliceStride();
+    const int k = static_cast<int>(v / slice);
+    const std::int64_t r = v - k * slice;
+    const int j = static_cast<int>(r / Dims[0]);
+    return { { static_cast<int>(r - static_cast<std::int64_t>(j) * Dims[0]), j, k } };
+  }
   bool Contains(int i, int j, int k) const
   {
     return i >= 0 && j >= 0 && k >= 0 && i < Dims[0] && j < Dims[1] && k < Dims[2];

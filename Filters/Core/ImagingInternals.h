@@ -32,11 +32,10 @@ inline float Diff(const float* f, std::int64_t idx, int coord, int dim, std::int
 
 inline void Coordinates(const ImageGeometry& g, std::int64_t idx, int& i, int& j, int& k)
 {
-  const std::int64_t slice = g.SliceStride();
-  k = static_cast<int>(idx / slice);
-  const std::int64_t r = idx - k * slice;
-  j = static_cast<int>(r / g.Dims[0]);
-  i = static_cast<int>(r - static_cast<std::int64_t>(j) * g.Dims[0]);
+  const std::array<int, 3> c = g.Coordinates(idx);
+  i = c[0];
+  j = c[1];
+  k = c[2];
 }
 } // namespace detail
 } // namespace featuremesh

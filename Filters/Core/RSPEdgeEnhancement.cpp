@@ -74,11 +74,13 @@ double RobustRange(const float* v, std::int64_t n)
 struct Grid
 {
   std::array<int, 3> Dims;
+  ImageGeometry Frame; // the dimensions only, for Coordinates
   int Directions; // 4 or 6
   std::array<std::int64_t, 6> Offset;
   explicit Grid(const std::array<int, 3>& dims)
     : Dims(dims)
   {
+    Frame.Dims = dims;
     Directions = dims[2] == 1 ? 4 : 6;
     const std::int64_t sy = dims[0], sz = static_cast<std::int64_t>(dims[0]) * dims[1];
     Offset = { { 1, -1, sy, -sy, sz, -sz } };
@@ -89,13 +91,7 @@ struct Grid
     const int a = d / 2, c = ijk[a] + ((d & 1) ? -1 : 1);
     return c >= 0 && c < Dims[a];
   }
-  std::array<int, 3> Coordinates(std::int64_t v) const
-  {
-    const std::int64_t sz = static_cast<std::int64_t>(Dims[0]) * Dims[1];
-    const int k = static_cast<int>(v / sz);
-    const std::int64_t r = v - k * sz;
-    return { { static_cast<int>(r % Dims[0]), static_cast<int>(r / Dims[0]), k } };
-  }
+  std::array<int, 3> Coordinates(std::int64_t v) const { return Frame.Coordinates(v); }
 };
 
 using HeapEntry = std::pair<double, std::int64_t>;
@@ -292,21 +288,17 @@ namespace
 struct PathBox
 {
   std::array<int, 3> Lo, Dims;
+  ImageGeometry Frame; // Dims only, for Coordinates
   std::int64_t Size() const { return static_cast<std::int64_t>(Dims[0]) * Dims[1] * Dims[2]; }
   std::int64_t Local(const ImageGeometry& g, std::int64_t v) const
   {
-    const std::int64_t sz = g.SliceStride();
-    const int k = static_cast<int>(v / sz);
-    const std::int64_t r = v - k * sz;
-    const int i = static_cast<int>(r % g.Dims[0]), j = static_cast<int>(r / g.Dims[0]);
-    return (static_cast<std::int64_t>(k - Lo[2]) * Dims[1] + (j - Lo[1])) * Dims[0] + (i - Lo[0]);
+    const std::array<int, 3> c = g.Coordinates(v);
+    return (static_cast<std::int64_t>(c[2] - Lo[2]) * Dims[1] + (c[1] - Lo[1])) * Dims[0] + (c[0] - Lo[0]);
   }
   std::int64_t Global(const ImageGeometry& g, std::int64_t l) const
   {
-    const std::int64_t sz = static_cast<std::int64_t>(Dims[0]) * Dims[1];
-    const int k = static_cast<int>(l / sz);
-    const std::int64_t r = l - k * sz;
-    return g.Index(static_cast<int>(r % Dims[0]) + Lo[0], static_cast<int>(r / Dims[0]) + Lo[1], k + Lo[2]);
+    const std::array<int, 3> c = Frame.Coordinates(l);
+    return g.Index(c[0] + Lo[0], c[1] + Lo[1], c[2] + Lo[2]);
   }
 };
 
@@ -409,10 +401,8 @@ RSPResult OnCoarserGrid(const float* image, const ImageGeometry& g, const std::v
   }
   const auto t0 = Clock::now();
   const auto block = [&](std::int64_t v) {
-    const std::int64_t sz = g.SliceStride();
-    const int k = static_cast<int>(v / sz);
-    const std::int64_t r = v - k * sz;
-    return c.Index(static_cast<int>(r % g.Dims[0]) / f, static_cast<int>(r / g.Dims[0]) / f, dim == 3 ? k / f : 0);
+    const std::array<int, 3> x = g.Coordinates(v);
+    return c.Index(x[0] / f, x[1] / f, dim == 3 ? x[2] / f : 0);
   };
   std::vector<float> coarse(static_cast<std::size_t>(c.Size()), 0.f);
   {
@@ -671,6 +661,7 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
       box.Dims[a] = std::min(g.Dims[a] - 1, hi[a] + p.PathMargin) - box.Lo[a] + 1;
     }
   }
+  box.Frame.Dims = box.Dims;
   out.PathVoxels = box.Size();
   if (box.Size() >= std::numeric_limits<std::uint32_t>::max())
   {
