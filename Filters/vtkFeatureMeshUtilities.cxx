@@ -22,6 +22,8 @@
 #include "vtkDemandDrivenPipeline.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkPointData.h"
+#include "vtkPolyData.h"
+#include "vtkStripper.h"
 #include "vtkSMPTools.h"
 #include "vtkType.h"
 
@@ -564,6 +566,32 @@ bool ChosenValues(vtkImageData* image, vtkInformation* arrayInfo, std::vector<do
 {
   vtkDataArray* array = ChosenArray(image, arrayInfo, error, warning);
   return array && ToDouble(array, values, error);
+}
+
+void BoundaryPolyData(vtkPoints* points, const std::vector<std::int64_t>& faces, int faceSize, vtkPolyData* output)
+{
+  vtkNew<vtkCellArray> cells;
+  for (std::size_t f = 0; f < faces.size(); f += faceSize)
+  {
+    const vtkIdType ids[3] = { faces[f], faces[f + 1], faceSize == 3 ? faces[f + 2] : 0 };
+    cells->InsertNextCell(faceSize, ids);
+  }
+  vtkNew<vtkPolyData> surface;
+  surface->SetPoints(points);
+  if (faceSize == 2)
+  {
+    surface->SetLines(cells);
+    vtkNew<vtkStripper> stripper;
+    stripper->SetInputData(surface);
+    stripper->JoinContiguousSegmentsOn();
+    stripper->Update();
+    output->ShallowCopy(stripper->GetOutput());
+  }
+  else
+  {
+    surface->SetPolys(cells);
+    output->ShallowCopy(surface);
+  }
 }
 
 void AddFieldValue(vtkDataObject* object, const char* name, double value)

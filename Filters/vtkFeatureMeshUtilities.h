@@ -23,7 +23,9 @@ class vtkImageData;
 class vtkInformation;
 class vtkInformationVector;
 class vtkPointData;
+class vtkPoints;
 class vtkPointSet;
+class vtkPolyData;
 class vtkUnstructuredGrid;
 
 namespace featuremesh
@@ -158,6 +160,10 @@ vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::s
 // `warning` is set when the chosen name fell back to the active scalars.
 bool ChosenValues(vtkImageData* image, vtkInformation* arrayInfo, std::vector<double>& values, std::string& error,
   std::string& warning);
+
+// A label boundary (faces of `faceSize` ids on `points`, as LabelBoundaryFaces gives them) as poly
+// data: 2D segments joined into polylines, 3D triangles.
+void BoundaryPolyData(vtkPoints* points, const std::vector<std::int64_t>& faces, int faceSize, vtkPolyData* output);
 
 // Adds a one-value double array `name` to the object's field data (summaries, timings).
 void AddFieldValue(vtkDataObject* object, const char* name, double value);

@@ -4,7 +4,6 @@
 #include "SuperVoxelCut.h"
 #include "vtkFeatureMeshUtilities.h"
 
-#include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkCellTypes.h"
 #include "vtkDataArray.h"
@@ -20,7 +19,6 @@
 #include "vtkPointSet.h"
 #include "vtkPolyData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
-#include "vtkStripper.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
 
@@ -213,30 +211,7 @@ int vtkSuperVoxelCut::RequestData(
     output->GetCellData()->SetActiveScalars(names::Label);
 
     // Output 1: the boundary, on the mesh's points (2D polylines, 3D a closed outward surface).
-    const int faceSize = mesh.VerticesPerCell() - 1;
-    vtkNew<vtkCellArray> faces;
-    for (size_t f = 0; f < result.BoundaryFaces.size(); f += faceSize)
-    {
-      const vtkIdType ids[3] = { result.BoundaryFaces[f], result.BoundaryFaces[f + 1],
-        faceSize == 3 ? result.BoundaryFaces[f + 2] : 0 };
-      faces->InsertNextCell(faceSize, ids);
-    }
-    vtkNew<vtkPolyData> surface;
-    surface->SetPoints(input->GetPoints());
-    if (faceSize == 2)
-    {
-      surface->SetLines(faces);
-      vtkNew<vtkStripper> stripper;
-      stripper->SetInputData(surface);
-      stripper->JoinContiguousSegmentsOn();
-      stripper->Update();
-      boundary->ShallowCopy(stripper->GetOutput());
-    }
-    else
-    {
-      surface->SetPolys(faces);
-      boundary->ShallowCopy(surface);
-    }
+    BoundaryPolyData(input->GetPoints(), result.BoundaryFaces, mesh.VerticesPerCell() - 1, boundary);
 
     // Output 2: the labels on the image grid.
     SetImageFrame(labelImage, geometry);

@@ -83,6 +83,20 @@ constexpr const char* BackgroundThreshold = "BackgroundThreshold";
 constexpr const char* GradientRange = "GradientRange";
 constexpr const char* MarchingSeconds = "MarchingSeconds";
 constexpr const char* PathSeconds = "PathSeconds";
+// Stage 6: what the smoothing did.
+constexpr const char* Shortfall = "Shortfall"; // point array: distance to the smoothed position (world units)
+constexpr const char* BoundaryNodes = "BoundaryNodes";
+constexpr const char* PinchedNodes = "PinchedNodes";         // non-manifold boundary nodes, kept in place
+constexpr const char* NonManifoldEdges = "NonManifoldEdges"; // 3D boundary edges of other than two faces
+constexpr const char* ShortNodes = "ShortNodes";             // boundary nodes short of their smoothed position
+constexpr const char* MaxShortfall = "MaxShortfall";         // world units
+constexpr const char* RelaxedNodes = "RelaxedNodes";
+constexpr const char* ObjectMeasureBefore = "ObjectMeasureBefore"; // object area (2D) / volume (3D), world units
+constexpr const char* ObjectMeasureAfter = "ObjectMeasureAfter";
+constexpr const char* MeasureChange = "MeasureChange";       // after / before - 1
+constexpr const char* SurfaceSeconds = "SurfaceSeconds";
+constexpr const char* VolumeSeconds = "VolumeSeconds";
+// Stage 4.
 constexpr const char* Sigma = "Sigma";
 constexpr const char* Bins = "Bins";
 constexpr const char* Flow = "Flow";

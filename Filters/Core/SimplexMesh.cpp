@@ -310,37 +310,96 @@ const CompressedRows& SimplexMesh::VertexNeighbours() const
   return *this->Cached->Neighbours;
 }
 
-std::vector<std::int64_t> LabelBoundaryFaces(const SimplexMesh& mesh, const std::vector<std::uint8_t>& label)
+std::vector<std::int64_t> LabelBoundaryFaces(
+  const SimplexMesh& mesh, const std::vector<std::uint8_t>& label, std::int64_t* interfaceFaces)
 {
-  const FaceAdjacency& adj = mesh.Faces();
-  const std::vector<std::array<double, 3>> frame = mesh.FramePoints();
+  // The faces of the object elements that no other object element shares: hashing the object's
+  // faces needs no adjacency of the whole mesh.
   const int vpc = mesh.VerticesPerCell();
-  const bool flip = mesh.Geometry().IsMirrored();
-  std::vector<std::int64_t> faces;
-  auto add = [&](std::int64_t element, int local) {
-    std::int64_t f[3];
-    OutwardFace(frame, mesh.Cell(element), vpc, local, f);
-    if (flip)
-    {
-      std::swap(f[0], f[1]);
-    }
-    faces.insert(faces.end(), f, f + vpc - 1);
+  struct Face
+  {
+    std::array<std::int64_t, 3> Key;
+    std::int64_t Element;
+    int Local;
   };
-  for (std::size_t e = 0; e < adj.A.size(); ++e)
+  std::vector<Face> faces;
+  for (std::int64_t e = 0; e < mesh.NumberOfElements(); ++e)
   {
-    const std::uint8_t la = label[adj.A[e]], lb = label[adj.B[e]];
-    if (la != lb)
+    if (!label[e])
     {
-      la ? add(adj.A[e], adj.LocalA[e]) : add(adj.B[e], adj.LocalB[e]);
+      continue;
+    }
+    const std::int64_t* cell = mesh.Cell(e);
+    for (int f = 0; f < vpc; ++f)
+    {
+      Face face{ { { -1, -1, -1 } }, e, f };
+      for (int k = 1, n = 0; k < vpc; ++k)
+      {
+        face.Key[n++] = cell[(f + k) % vpc];
+      }
+      std::sort(face.Key.begin(), face.Key.begin() + vpc - 1);
+      faces.push_back(face);
     }
   }
-  for (std::size_t h = 0; h < adj.HullElement.size(); ++h)
-  {
-    if (label[adj.HullElement[h]])
+  std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.Key < b.Key; });
+  // A face on the image box lies in one box plane: every vertex has the same extreme index on one axis.
+  const ImageGeometry& g = mesh.Geometry();
+  const auto& P = mesh.Points();
+  auto onBox = [&](const Face& face) {
+    for (int a = 0; a < g.Dimension(); ++a)
     {
-      add(adj.HullElement[h], adj.HullFace[h]);
+      for (const double side : { 0.0, g.Dims[a] - 1.0 })
+      {
+        bool all = true;
+        for (int k = 0; all && k < vpc - 1; ++k)
+        {
+          all = P[face.Key[k]][a] == side;
+        }
+        if (all)
+        {
+          return true;
+        }
+      }
+    }
+    return false;
+  };
+  std::vector<std::pair<std::int64_t, int>> inner, hull;
+  for (std::size_t i = 0; i < faces.size();)
+  {
+    std::size_t j = i + 1;
+    while (j < faces.size() && faces[j].Key == faces[i].Key)
+    {
+      ++j;
+    }
+    if (j == i + 1)
+    {
+      (onBox(faces[i]) ? hull : inner).emplace_back(faces[i].Element, faces[i].Local);
+    }
+    i = j;
+  }
+  std::sort(inner.begin(), inner.end());
+  std::sort(hull.begin(), hull.end());
+  if (interfaceFaces)
+  {
+    *interfaceFaces = static_cast<std::int64_t>(inner.size());
+  }
+  const std::vector<std::array<double, 3>> frame = mesh.FramePoints();
+  const bool flip = mesh.Geometry().IsMirrored();
+  std::vector<std::int64_t> out;
+  out.reserve((inner.size() + hull.size()) * (vpc - 1));
+  for (const auto* list : { &inner, &hull })
+  {
+    for (const auto& face : *list)
+    {
+      std::int64_t f[3];
+      OutwardFace(frame, mesh.Cell(face.first), vpc, face.second, f);
+      if (flip)
+      {
+        std::swap(f[0], f[1]);
+      }
+      out.insert(out.end(), f, f + vpc - 1);
     }
   }
-  return faces;
+  return out;
 }
 } // namespace featuremesh

@@ -95,6 +95,8 @@ void OutwardFace(const std::vector<std::array<double, 3>>& points, const std::in
 
 // The faces between elements labelled 1 and 0, and the hull faces of elements labelled 1, each
 // oriented out of the labelled region in world coordinates (mirrored frames flip it): vpc - 1 ids
-// per face, interior faces first in face order, then hull faces.
-std::vector<std::int64_t> LabelBoundaryFaces(const SimplexMesh& mesh, const std::vector<std::uint8_t>& label);
+// per face, interface faces first, then hull faces, each in order of (element, local face).
+// `interfaceFaces` receives the number of interface faces. Needs no face adjacency.
+std::vector<std::int64_t> LabelBoundaryFaces(
+  const SimplexMesh& mesh, const std::vector<std::uint8_t>& label, std::int64_t* interfaceFaces = nullptr);
 } // namespace featuremesh

@@ -13,6 +13,7 @@
 #include "SimplexMesh.h"
 #include "SeedConnectivity.h"
 #include "SuperVoxelCut.h"
+#include "SurfaceSmoothing.h"
 
 #include <gtest/gtest.h>
 
@@ -1578,4 +1579,168 @@ TEST(FeatureNodes, SeedAwareNodesAreFineAtTheEdgeMapAndCoarseAwayFromIt)
     kept += map[v] && aware.EdgeMap[v];
   }
   EXPECT_EQ(kept, mapVoxels);
+}
+
+namespace
+{
+// Voxel staircases: the cells of an n^d lattice (squares split in two triangles, cubes in the six
+// Kuhn tetrahedra), labelled 1 when the cell's centre lies in the ball of radius `radius` round
+// `centre`. The ball crosses the box face x = 0.
+struct Staircase
+{
+  SimplexMesh Mesh;
+  std::vector<std::uint8_t> Label;
+};
+
+Staircase StaircaseBall(int dim, int n, const std::array<double, 3>& centre, double radius)
+{
+  ImageGeometry g;
+  g.Dims = { { n + 1, n + 1, dim == 3 ? n + 1 : 1 } };
+  g.Spacing = { { 1.0, 1.5, 0.75 } }; // anisotropic: the smoothing works in world units
+  std::vector<std::array<double, 3>> pts;
+  for (int k = 0; k < g.Dims[2]; ++k)
+    for (int j = 0; j < g.Dims[1]; ++j)
+      for (int i = 0; i < g.Dims[0]; ++i)
+        pts.push_back({ { double(i), double(j), double(k) } });
+  std::vector<std::int64_t> cells;
+  std::vector<std::uint8_t> label;
+  const int perms[6][3] = { { 0, 1, 2 }, { 0, 2, 1 }, { 1, 0, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 2, 1, 0 } };
+  for (int k = 0; k < (dim == 3 ? n : 1); ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+      {
+        const std::array<double, 3> c = { { (i + 0.5) * g.Spacing[0], (j + 0.5) * g.Spacing[1], dim == 3 ? (k + 0.5) * g.Spacing[2] : 0.0 } };
+        const double r = std::hypot(c[0] - centre[0], c[1] - centre[1], c[2] - centre[2]);
+        auto id = [&](int di, int dj, int dk) { return g.Index(i + di, j + dj, k + dk); };
+        if (dim == 2)
+        {
+          const std::int64_t tri[6] = { id(0, 0, 0), id(1, 0, 0), id(1, 1, 0), id(0, 0, 0), id(1, 1, 0), id(0, 1, 0) };
+          cells.insert(cells.end(), tri, tri + 6);
+          label.insert(label.end(), 2, r < radius);
+          continue;
+        }
+        for (const auto& p : perms)
+        {
+          std::array<int, 3> at = { { 0, 0, 0 } };
+          cells.push_back(id(0, 0, 0));
+          for (int s = 0; s < 3; ++s)
+          {
+            at[p[s]] = 1;
+            cells.push_back(id(at[0], at[1], at[2]));
+          }
+          label.push_back(r < radius);
+        }
+      }
+  Staircase s{ SimplexMesh(g, pts, cells, dim == 3 ? 4 : 3), label };
+  s.Mesh.OrientPositively();
+  return s;
+}
+
+// Mean distance (world units) of the boundary nodes off the box to the true sphere.
+double MeanDistanceToSphere(const SimplexMesh& mesh, const std::vector<std::array<double, 3>>& points,
+  const std::vector<std::int64_t>& faces, const std::array<double, 3>& centre, double radius)
+{
+  std::set<std::int64_t> nodes(faces.begin(), faces.end());
+  double sum = 0;
+  int count = 0;
+  for (const std::int64_t v : nodes)
+  {
+    if (mesh.Points()[v][0] == 0.0)
+    {
+      continue;
+    }
+    const auto f = mesh.Geometry().IndexToFrame(points[v]);
+    sum += std::fabs(std::hypot(f[0] - centre[0], f[1] - centre[1], f[2] - centre[2]) - radius);
+    ++count;
+  }
+  return sum / count;
+}
+} // namespace
+
+TEST(SurfaceSmoothing, StaircaseBallComesCloserToTheSphereAndTheMeshStaysValid)
+{
+  for (const int dim : { 2, 3 })
+  {
+    const std::array<double, 3> centre = { { 3.0, 13.0, dim == 3 ? 9.0 : 0.0 } };
+    const double radius = 8.0;
+    const Staircase s = StaircaseBall(dim, dim == 3 ? 18 : 24, centre, radius);
+    ASSERT_TRUE(s.Mesh.Validate().empty());
+    std::vector<double> before, ratio;
+    ElementQuality(s.Mesh, before, ratio, SerialFor());
+    const std::vector<std::int64_t> faces = LabelBoundaryFaces(s.Mesh, s.Label);
+    const double staircase = MeanDistanceToSphere(s.Mesh, s.Mesh.Points(), faces, centre, radius);
+    for (const auto method : { SurfaceSmoothingMethod::Laplacian, SurfaceSmoothingMethod::Taubin })
+    {
+      SCOPED_TRACE(std::to_string(dim) + "D, method " + std::to_string(int(method)));
+      SurfaceSmoothingParameters p;
+      p.Method = method;
+      p.Iterations = method == SurfaceSmoothingMethod::Taubin ? 10 : 3;
+      const SurfaceSmoothingResult r = SmoothSegmentationSurface(s.Mesh, s.Label, p, SerialFor());
+      ASSERT_TRUE(r.Error.empty()) << r.Error;
+      EXPECT_EQ(r.Faces, faces);
+      EXPECT_GT(r.InterfaceFaces, 0);
+      EXPECT_LT(r.InterfaceFaces * (dim), std::int64_t(faces.size()));
+      EXPECT_EQ(r.PinchedNodes, 0);
+      EXPECT_EQ(r.BoundaryPoints, r.Points);
+      const double smoothed = MeanDistanceToSphere(s.Mesh, r.Points, faces, centre, radius);
+      EXPECT_LT(smoothed, 0.8 * staircase) << staircase << " -> " << smoothed;
+      // Most boundary nodes reach their smoothed position (those whose star would flatten stop short);
+      // none moves off its box face.
+      EXPECT_LT(r.ShortNodes, r.BoundaryNodes / 4);
+      EXPECT_LT(r.MaxShortfall, 0.4);
+      SimplexMesh moved = s.Mesh;
+      moved.SetPoints(r.Points);
+      std::vector<double> after;
+      ElementQuality(moved, after, ratio, SerialFor());
+      const double floor = dim == 2 ? p.MinAngle : p.MinDihedralAngle;
+      for (std::int64_t e = 0; e < moved.NumberOfElements(); ++e)
+      {
+        ASSERT_GT(ElementMeasure(r.Points, moved.Cell(e), moved.VerticesPerCell()), 0.0) << e;
+        ASSERT_GE(after[e], std::min(floor, before[e]) - 1e-9) << e;
+      }
+      for (std::int64_t v = 0; v < moved.NumberOfPoints(); ++v)
+      {
+        for (int a = 0; a < dim; ++a)
+        {
+          const double was = s.Mesh.Points()[v][a];
+          if (was == 0.0 || was == s.Mesh.Geometry().Dims[a] - 1.0)
+          {
+            ASSERT_EQ(r.Points[v][a], was) << v;
+          }
+        }
+      }
+      // Laplacian shrinks; Taubin keeps the measure within 1 %.
+      const double change = r.ObjectMeasureAfter / r.ObjectMeasureBefore - 1.0;
+      if (method == SurfaceSmoothingMethod::Taubin)
+      {
+        EXPECT_LT(std::fabs(change), 0.01);
+      }
+      else
+      {
+        EXPECT_LT(change, 0.0);
+      }
+      std::cout << dim << "D method " << int(method) << ": distance " << staircase << " -> " << smoothed
+                << ", measure change " << change << ", short " << r.ShortNodes << "/" << r.BoundaryNodes
+                << ", relaxed " << r.RelaxedNodes << ", max shortfall " << r.MaxShortfall << "\n";
+    }
+  }
+}
+
+TEST(SurfaceSmoothing, BadInputIsNamed)
+{
+  const Staircase s = StaircaseBall(2, 8, { { 4, 4, 0 } }, 3.0);
+  SurfaceSmoothingParameters p;
+  p.Relaxation = 0;
+  EXPECT_FALSE(SmoothSegmentationSurface(s.Mesh, s.Label, p, SerialFor()).Error.empty());
+  std::vector<std::uint8_t> bad = s.Label;
+  bad[0] = 2;
+  EXPECT_FALSE(SmoothSegmentationSurface(s.Mesh, bad, SurfaceSmoothingParameters(), SerialFor()).Error.empty());
+  bad.pop_back();
+  EXPECT_FALSE(SmoothSegmentationSurface(s.Mesh, bad, SurfaceSmoothingParameters(), SerialFor()).Error.empty());
+  // No object: nothing moves.
+  const SurfaceSmoothingResult none =
+    SmoothSegmentationSurface(s.Mesh, std::vector<std::uint8_t>(s.Label.size(), 0), SurfaceSmoothingParameters(), SerialFor());
+  EXPECT_TRUE(none.Error.empty());
+  EXPECT_TRUE(none.Faces.empty());
+  EXPECT_EQ(none.Points, s.Mesh.Points());
 }

@@ -45,7 +45,7 @@ def load_plugin(path=None, ns=None):
         _loaded.append(True)
     if ns is not None:
         for name in ("FeatureNodes", "DelaunayImageMesh", "ImageMeshSmoothing", "RSPEdgeEnhancement", "SuperVoxelCut",
-                     "VoxelCut"):
+                     "VoxelCut", "SegmentationSurfaceSmoothing"):
             ns[name] = getattr(ps, name)
 
 
@@ -122,6 +122,10 @@ class Case:
     def super_voxel_cut(self, mesh, **properties):
         return ps.SuperVoxelCut(Mesh=mesh, ObjectSeeds=self.object_seeds, BackgroundSeeds=self.background_seeds,
                                 Image=self.image, Scalars=self.scalars, **properties)
+
+    def surface_smoothing(self, cut, **properties):
+        """Segmentation Surface Smoothing of a Super-Voxel Cut proxy (port 0 the smoothed boundary, 1 the labelled mesh)."""
+        return ps.SegmentationSurfaceSmoothing(LabelledMesh=ps.OutputPort(cut, 0), **properties)
 
     def voxel_cut(self, **properties):
         return ps.VoxelCut(Input=self.image, ObjectSeeds=self.object_seeds, BackgroundSeeds=self.background_seeds,

@@ -1,0 +1,647 @@
+#include "SurfaceSmoothing.h"
+
+#include "MeshSmoothing.h"
+#include "Vector3.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <unordered_map>
+
+namespace featuremesh
+{
+namespace
+{
+using namespace vector3;
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point since)
+{
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+// Rows of ids from (row, id) pairs: each row sorted, duplicates dropped (a counting sort by row).
+CompressedRows RowsFromPairs(std::int64_t rows, const std::vector<std::pair<std::int64_t, std::int64_t>>& pairs)
+{
+  std::vector<std::int64_t> offsets(rows + 1, 0), ids(pairs.size());
+  for (const auto& p : pairs)
+  {
+    ++offsets[p.first + 1];
+  }
+  for (std::int64_t i = 0; i < rows; ++i)
+  {
+    offsets[i + 1] += offsets[i];
+  }
+  std::vector<std::int64_t> fill(offsets.begin(), offsets.end() - 1);
+  for (const auto& p : pairs)
+  {
+    ids[fill[p.first]++] = p.second;
+  }
+  CompressedRows r;
+  r.Offsets.assign(rows + 1, 0);
+  r.Ids.reserve(ids.size());
+  for (std::int64_t i = 0; i < rows; ++i)
+  {
+    const auto begin = ids.begin() + offsets[i], end = ids.begin() + offsets[i + 1];
+    std::sort(begin, end);
+    r.Ids.insert(r.Ids.end(), begin, std::unique(begin, end));
+    r.Offsets[i + 1] = static_cast<std::int64_t>(r.Ids.size());
+  }
+  return r;
+}
+
+// The boundary as a graph on its own nodes (local ids): neighbours, and the nodes where it is not a
+// manifold.
+struct Boundary
+{
+  std::vector<std::int64_t> Node;  // local -> mesh point id
+  std::vector<std::int64_t> Faces; // local ids, vpc - 1 per face
+  CompressedRows Neighbours;
+  std::vector<std::uint8_t> Pinched;
+  std::int64_t NonManifoldEdges = 0;
+};
+
+Boundary BoundaryGraph(std::int64_t nPoints, const std::vector<std::int64_t>& faces, int faceSize)
+{
+  Boundary b;
+  std::vector<std::int64_t> local(nPoints, -1);
+  b.Faces.resize(faces.size());
+  for (std::size_t i = 0; i < faces.size(); ++i)
+  {
+    std::int64_t& l = local[faces[i]];
+    if (l < 0)
+    {
+      l = static_cast<std::int64_t>(b.Node.size());
+      b.Node.push_back(faces[i]);
+    }
+    b.Faces[i] = l;
+  }
+  const std::int64_t n = static_cast<std::int64_t>(b.Node.size());
+  const std::int64_t nFaces = static_cast<std::int64_t>(faces.size()) / faceSize;
+  b.Pinched.assign(n, 0);
+  std::vector<std::pair<std::int64_t, std::int64_t>> pairs;
+  pairs.reserve(faces.size() * 2);
+  if (faceSize == 2)
+  {
+    std::vector<int> degree(n, 0);
+    for (std::int64_t f = 0; f < nFaces; ++f)
+    {
+      const std::int64_t a = b.Faces[2 * f], c = b.Faces[2 * f + 1];
+      pairs.emplace_back(a, c);
+      pairs.emplace_back(c, a);
+      ++degree[a];
+      ++degree[c];
+    }
+    for (std::int64_t i = 0; i < n; ++i)
+    {
+      b.Pinched[i] = degree[i] != 2;
+    }
+    b.Neighbours = RowsFromPairs(n, pairs);
+    return b;
+  }
+  // 3D: directed edges a -> c of the faces (each face's three, in its orientation).
+  std::vector<std::pair<std::int64_t, std::int64_t>> directed;
+  directed.reserve(faces.size());
+  for (std::int64_t f = 0; f < nFaces; ++f)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      const std::int64_t a = b.Faces[3 * f + k], c = b.Faces[3 * f + (k + 1) % 3];
+      directed.emplace_back(a, c);
+      pairs.emplace_back(a, c);
+      pairs.emplace_back(c, a);
+    }
+  }
+  // An edge of other than two faces (each side once) pinches both its ends.
+  std::vector<std::pair<std::int64_t, std::int64_t>> undirected(directed.size());
+  std::transform(directed.begin(), directed.end(), undirected.begin(),
+    [](const std::pair<std::int64_t, std::int64_t>& e) { return std::minmax(e.first, e.second); });
+  std::sort(undirected.begin(), undirected.end());
+  for (std::size_t i = 0; i < undirected.size();)
+  {
+    std::size_t j = i;
+    while (j < undirected.size() && undirected[j] == undirected[i])
+    {
+      ++j;
+    }
+    if (j - i != 2)
+    {
+      ++b.NonManifoldEdges;
+      b.Pinched[undirected[i].first] = b.Pinched[undirected[i].second] = 1;
+    }
+    i = j;
+  }
+  // A vertex whose faces make several fans: its link (the edge opposite it in each face) is not one
+  // cycle.
+  std::vector<std::pair<std::int64_t, std::int64_t>> incidence;
+  incidence.reserve(faces.size());
+  for (std::int64_t f = 0; f < nFaces; ++f)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      incidence.emplace_back(b.Faces[3 * f + k], f);
+    }
+  }
+  const CompressedRows star = RowsFromPairs(n, incidence);
+  std::unordered_map<std::int64_t, std::int64_t> next;
+  for (std::int64_t v = 0; v < n; ++v)
+  {
+    if (b.Pinched[v])
+    {
+      continue;
+    }
+    next.clear();
+    for (const std::int64_t* f = star.Begin(v); f != star.End(v); ++f)
+    {
+      const std::int64_t* t = &b.Faces[3 * *f];
+      const int k = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+      next[t[(k + 1) % 3]] = t[(k + 2) % 3];
+    }
+    std::int64_t steps = 0;
+    std::int64_t x = next.begin()->first;
+    do
+    {
+      const auto it = next.find(x);
+      if (it == next.end())
+      {
+        break;
+      }
+      x = it->second;
+      ++steps;
+    } while (x != next.begin()->first && steps <= star.Size(v));
+    b.Pinched[v] = !(x == next.begin()->first && steps == star.Size(v) && static_cast<std::int64_t>(next.size()) == steps);
+  }
+  b.Neighbours = RowsFromPairs(n, pairs);
+  return b;
+}
+
+// Enclosed measure of the boundary (frame coordinates): the divergence theorem over its faces.
+double EnclosedMeasure(const std::vector<V3>& frame, const std::vector<std::int64_t>& faces, int faceSize)
+{
+  double sum = 0.0;
+  for (std::size_t f = 0; f < faces.size(); f += faceSize)
+  {
+    const V3 &a = frame[faces[f]], &b = frame[faces[f + 1]];
+    sum += faceSize == 2 ? a[0] * b[1] - a[1] * b[0] : Dot(a, Cross(b, frame[faces[f + 2]]));
+  }
+  return std::fabs(sum) / (faceSize == 2 ? 2.0 : 6.0);
+}
+
+// The labelled mesh while its nodes move: each move is taken only when the node's star stays
+// positively oriented and above its floors.
+struct VolumeMover
+{
+  const SimplexMesh& Mesh;
+  const CompressedRows& Stars;
+  std::vector<V3>& Frame;
+  std::vector<double> CosFloor; // cosine of each element's quality floor
+  int Vpc;
+
+  // The largest cosine of the element's angles (2D) or dihedral angles (3D): its smallest angle,
+  // compared without an inverse cosine.
+  double MaxCosine(std::int64_t e) const
+  {
+    const std::int64_t* c = this->Mesh.Cell(e);
+    double largest = -1.0;
+    if (this->Vpc == 3)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        const V3 u = Sub(this->Frame[c[(k + 1) % 3]], this->Frame[c[k]]);
+        const V3 w = Sub(this->Frame[c[(k + 2) % 3]], this->Frame[c[k]]);
+        largest = std::max(largest, Dot(u, w) / std::sqrt(Dot(u, u) * Dot(w, w)));
+      }
+      return largest;
+    }
+    // Outward face normals; the dihedral angle at the edge of faces k and l has cosine -n_k.n_l.
+    V3 normal[4];
+    for (int f = 0; f < 4; ++f)
+    {
+      const V3& a = this->Frame[c[(f + 1) % 4]];
+      normal[f] = Cross(Sub(this->Frame[c[(f + 2) % 4]], a), Sub(this->Frame[c[(f + 3) % 4]], a));
+      const double length = Norm(normal[f]) * (Dot(normal[f], Sub(this->Frame[c[f]], a)) > 0 ? -1.0 : 1.0);
+      normal[f] = { { normal[f][0] / length, normal[f][1] / length, normal[f][2] / length } };
+    }
+    for (int k = 0; k < 4; ++k)
+    {
+      for (int l = k + 1; l < 4; ++l)
+      {
+        largest = std::max(largest, -Dot(normal[k], normal[l]));
+      }
+    }
+    return largest;
+  }
+
+  bool Valid(std::int64_t e) const
+  {
+    return ElementMeasure(this->Frame, this->Mesh.Cell(e), this->Vpc) > 0.0 && this->MaxCosine(e) <= this->CosFloor[e];
+  }
+
+  // The star's largest cosine (lower is better), 2 when an element is inverted or flat.
+  double StarCosine(std::int64_t node) const
+  {
+    double largest = -1.0;
+    for (const std::int64_t* e = this->Stars.Begin(node); e != this->Stars.End(node); ++e)
+    {
+      if (!(ElementMeasure(this->Frame, this->Mesh.Cell(*e), this->Vpc) > 0.0))
+      {
+        return 2.0;
+      }
+      largest = std::max(largest, this->MaxCosine(*e));
+    }
+    return largest;
+  }
+
+  // Moves `node` to `to` when its star allows it; `improve` also asks for a better star minimum.
+  bool TryMove(std::int64_t node, const V3& to, bool improve = false)
+  {
+    const V3 from = this->Frame[node];
+    const double before = improve ? this->StarCosine(node) : 0.0;
+    this->Frame[node] = to;
+    bool ok = true;
+    for (const std::int64_t* e = this->Stars.Begin(node); ok && e != this->Stars.End(node); ++e)
+    {
+      ok = this->Valid(*e);
+    }
+    if (ok && improve)
+    {
+      ok = this->StarCosine(node) < before;
+    }
+    if (!ok)
+    {
+      this->Frame[node] = from;
+    }
+    return ok;
+  }
+};
+
+V3 Masked(const V3& from, const V3& to, std::uint8_t axes)
+{
+  V3 r = from;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (axes & (1 << a))
+    {
+      r[a] = to[a];
+    }
+  }
+  return r;
+}
+
+V3 Lerp(const V3& a, const V3& b, double t)
+{
+  return { { a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2]) } };
+}
+} // namespace
+
+std::string ValidateParameters(const SurfaceSmoothingParameters& p)
+{
+  if (p.Method != SurfaceSmoothingMethod::Laplacian && p.Method != SurfaceSmoothingMethod::Taubin)
+  {
+    return "Method must be 0 (Laplacian) or 1 (Taubin).";
+  }
+  if (p.Iterations < 0 || p.Iterations > 1000)
+  {
+    return "Iterations must be between 0 and 1000.";
+  }
+  if (!(p.Relaxation > 0.0 && p.Relaxation <= 1.0))
+  {
+    return "Relaxation must be in (0, 1].";
+  }
+  if (!(p.PassBand > 0.0 && p.PassBand < 1.0 / p.Relaxation))
+  {
+    return "PassBand must be positive and below 1 / Relaxation (Taubin's mu must be negative).";
+  }
+  if (!(p.MinAngle >= 0.0 && p.MinAngle <= 60.0) || !(p.MinDihedralAngle >= 0.0 && p.MinDihedralAngle <= 70.0))
+  {
+    return "MinAngle must be in [0, 60] and MinDihedralAngle in [0, 70] degrees.";
+  }
+  if (p.RelaxationRings < 0 || p.RelaxationRings > 20)
+  {
+    return "RelaxationRings must be between 0 and 20.";
+  }
+  return std::string();
+}
+
+SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const std::vector<std::uint8_t>& label,
+  const SurfaceSmoothingParameters& p, const ParallelFor& parallel, const ProgressFunction& progress)
+{
+  SurfaceSmoothingResult r;
+  r.Error = ValidateParameters(p);
+  const std::int64_t nElements = mesh.NumberOfElements();
+  if (r.Error.empty() && static_cast<std::int64_t>(label.size()) != nElements)
+  {
+    r.Error = "there must be one label per element.";
+  }
+  if (r.Error.empty() && std::any_of(label.begin(), label.end(), [](std::uint8_t l) { return l > 1; }))
+  {
+    r.Error = "the labels must be 0 (background) or 1 (object), as the Super-Voxel Cut writes them.";
+  }
+  if (!r.Error.empty())
+  {
+    return r;
+  }
+  auto start = Clock::now();
+  const int vpc = mesh.VerticesPerCell();
+  const int faceSize = vpc - 1;
+  r.Points = mesh.Points();
+  r.Faces = LabelBoundaryFaces(mesh, label, &r.InterfaceFaces);
+  std::vector<V3> frame = mesh.FramePoints();
+  r.ObjectMeasureBefore = EnclosedMeasure(frame, r.Faces, faceSize);
+  r.Shortfall.assign(frame.size(), 0.0);
+  if (r.Faces.empty())
+  {
+    r.ObjectMeasureAfter = r.ObjectMeasureBefore;
+    r.BoundaryPoints = r.Points;
+    r.SurfaceSeconds = Seconds(start);
+    return r;
+  }
+
+  // The boundary's targets.
+  const Boundary b = BoundaryGraph(mesh.NumberOfPoints(), r.Faces, faceSize);
+  const std::int64_t n = static_cast<std::int64_t>(b.Node.size());
+  r.BoundaryNodes = n;
+  r.NonManifoldEdges = b.NonManifoldEdges;
+  const std::vector<std::uint8_t> freeAxes = FreeAxes(mesh, std::vector<std::uint8_t>());
+  std::vector<std::uint8_t> axes(n);
+  std::vector<V3> x(n), next(n);
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    axes[i] = b.Pinched[i] ? 0 : freeAxes[b.Node[i]];
+    r.PinchedNodes += b.Pinched[i];
+    x[i] = frame[b.Node[i]];
+  }
+  std::vector<double> factors{ p.Relaxation };
+  if (p.Method == SurfaceSmoothingMethod::Taubin)
+  {
+    factors.push_back(1.0 / (p.PassBand - 1.0 / p.Relaxation));
+  }
+  for (int it = 0; it < p.Iterations; ++it)
+  {
+    for (const double factor : factors)
+    {
+      parallel(n, 4096, [&](std::int64_t begin, std::int64_t end) {
+        for (std::int64_t i = begin; i < end; ++i)
+        {
+          next[i] = x[i];
+          const std::int64_t k = b.Neighbours.Size(i);
+          if (!axes[i] || k == 0)
+          {
+            continue;
+          }
+          V3 mean = { { 0, 0, 0 } };
+          for (const std::int64_t* j = b.Neighbours.Begin(i); j != b.Neighbours.End(i); ++j)
+          {
+            for (int a = 0; a < 3; ++a)
+            {
+              mean[a] += x[*j][a] / k;
+            }
+          }
+          next[i] = Masked(x[i], Lerp(x[i], mean, factor), axes[i]);
+        }
+      });
+      std::swap(x, next);
+    }
+  }
+  r.SurfaceSeconds = Seconds(start);
+  if (!progress(0.2))
+  {
+    r.Aborted = true;
+    return r;
+  }
+
+  start = Clock::now();
+  const ImageGeometry& g = mesh.Geometry();
+  auto toIndex = [&](std::int64_t node, const V3& f) {
+    // Axes a node may not move along keep their index value exactly (box faces stay planar).
+    const V3 moved = g.FrameToIndex(f);
+    return Masked(mesh.Points()[node], moved, freeAxes[node]);
+  };
+  if (!p.VolumeMesh)
+  {
+    r.BoundaryPoints = r.Points;
+    std::vector<V3> smoothed = frame;
+    for (std::int64_t i = 0; i < n; ++i)
+    {
+      r.BoundaryPoints[b.Node[i]] = toIndex(b.Node[i], x[i]);
+      smoothed[b.Node[i]] = x[i];
+    }
+    r.ObjectMeasureAfter = EnclosedMeasure(smoothed, r.Faces, faceSize);
+    return r;
+  }
+
+  // Rings around the boundary (passes over the elements), the elements they touch (the band), and
+  // the band nodes' stars and neighbours.
+  const std::int64_t nPoints = mesh.NumberOfPoints();
+  std::vector<int> ring(nPoints, -1);
+  std::vector<std::vector<std::int64_t>> rings(1);
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    ring[b.Node[i]] = 0;
+  }
+  rings[0] = b.Node;
+  std::sort(rings[0].begin(), rings[0].end());
+  for (int k = 1; k <= p.RelaxationRings; ++k)
+  {
+    rings.emplace_back();
+    for (std::int64_t e = 0; e < nElements; ++e)
+    {
+      const std::int64_t* c = mesh.Cell(e);
+      if (std::any_of(c, c + vpc, [&](std::int64_t v) { return ring[v] == k - 1; }))
+      {
+        for (int j = 0; j < vpc; ++j)
+        {
+          if (ring[c[j]] < 0)
+          {
+            ring[c[j]] = k;
+            rings[k].push_back(c[j]);
+          }
+        }
+      }
+    }
+    std::sort(rings[k].begin(), rings[k].end());
+  }
+  std::vector<std::pair<std::int64_t, std::int64_t>> starPairs, neighbourPairs;
+  std::vector<std::int64_t> band;
+  for (std::int64_t e = 0; e < nElements; ++e)
+  {
+    const std::int64_t* c = mesh.Cell(e);
+    if (std::none_of(c, c + vpc, [&](std::int64_t v) { return ring[v] >= 0; }))
+    {
+      continue;
+    }
+    band.push_back(e);
+    for (int j = 0; j < vpc; ++j)
+    {
+      if (ring[c[j]] >= 0)
+      {
+        starPairs.emplace_back(c[j], e);
+        for (int l = 0; l < vpc; ++l)
+        {
+          if (l != j)
+          {
+            neighbourPairs.emplace_back(c[j], c[l]);
+          }
+        }
+      }
+    }
+  }
+  const CompressedRows stars = RowsFromPairs(nPoints, starPairs);
+  const CompressedRows neighbours = RowsFromPairs(nPoints, neighbourPairs);
+  if (!progress(0.3))
+  {
+    r.Aborted = true;
+    return r;
+  }
+
+  // Each ring's share of the move: the mean of the inner ring's, fading linearly to zero past the
+  // last ring.
+  std::vector<V3> move(nPoints, V3{ { 0, 0, 0 } });
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    move[b.Node[i]] = Sub(x[i], frame[b.Node[i]]);
+  }
+  for (int k = 1; k <= p.RelaxationRings; ++k)
+  {
+    const double share = 1.0 - 1.0 / (p.RelaxationRings + 2 - k);
+    for (const std::int64_t v : rings[k])
+    {
+      V3 mean = { { 0, 0, 0 } };
+      int count = 0;
+      for (const std::int64_t* w = neighbours.Begin(v); w != neighbours.End(v); ++w)
+      {
+        if (ring[*w] == k - 1)
+        {
+          for (int a = 0; a < 3; ++a)
+          {
+            mean[a] += move[*w][a];
+          }
+          ++count;
+        }
+      }
+      for (int a = 0; a < 3; ++a)
+      {
+        mean[a] *= share / count;
+      }
+      move[v] = Masked(V3{ { 0, 0, 0 } }, mean, freeAxes[v]);
+    }
+  }
+
+  VolumeMover mover{ mesh, stars, frame, std::vector<double>(nElements, 1.0), vpc };
+  const double cosFloor = std::cos((faceSize == 2 ? p.MinAngle : p.MinDihedralAngle) * 3.14159265358979323846 / 180.0);
+  for (const std::int64_t e : band)
+  {
+    // The element's own angle when lower (a hair below, so that rounding never blocks a move that
+    // keeps it).
+    mover.CosFloor[e] = std::max(mover.MaxCosine(e) + 1e-12, cosFloor);
+  }
+  const std::vector<V3> start0 = frame;
+  std::vector<V3> target(nPoints);
+  for (std::int64_t v = 0; v < nPoints; ++v)
+  {
+    target[v] = ring[v] < 0 ? frame[v] : V3{ { frame[v][0] + move[v][0], frame[v][1] + move[v][1], frame[v][2] + move[v][2] } };
+  }
+  // Steps along the moves, boundary first, then ring by ring; a node that cannot take a step
+  // tries half of it.
+  const int steps = 4;
+  for (int s = 1; s <= steps; ++s)
+  {
+    const double t = static_cast<double>(s) / steps;
+    for (const auto& nodes : rings)
+    {
+      for (const std::int64_t v : nodes)
+      {
+        if (target[v] == start0[v])
+        {
+          continue;
+        }
+        const V3 to = Lerp(start0[v], target[v], t);
+        if (!mover.TryMove(v, to))
+        {
+          mover.TryMove(v, Lerp(frame[v], to, 0.5));
+        }
+      }
+    }
+    if (!progress(0.2 + 0.5 * t))
+    {
+      r.Aborted = true;
+      return r;
+    }
+  }
+  // Boundary nodes that stopped short: their neighbours off the boundary make room (moves that raise
+  // their star's quality), then they try again.
+  auto shortfall = [&](std::int64_t i) { return Norm(Sub(frame[b.Node[i]], x[i])); };
+  const double tolerance = 1e-9 * std::max({ std::fabs(g.Spacing[0]), std::fabs(g.Spacing[1]), std::fabs(g.Spacing[2]) });
+  std::vector<std::uint8_t> relaxed(nPoints, 0);
+  for (int round = 0; round < 3; ++round)
+  {
+    std::vector<std::int64_t> stuck;
+    for (std::int64_t i = 0; i < n; ++i)
+    {
+      if (shortfall(i) > tolerance)
+      {
+        stuck.push_back(i);
+      }
+    }
+    if (stuck.empty())
+    {
+      break;
+    }
+    std::int64_t progressMade = 0;
+    for (const std::int64_t i : stuck)
+    {
+      const std::int64_t v = b.Node[i];
+      for (const std::int64_t* w = neighbours.Begin(v); w != neighbours.End(v); ++w)
+      {
+        if (ring[*w] > 0 && freeAxes[*w])
+        {
+          V3 mean = { { 0, 0, 0 } };
+          const std::int64_t k = neighbours.Size(*w);
+          for (const std::int64_t* u = neighbours.Begin(*w); u != neighbours.End(*w); ++u)
+          {
+            for (int a = 0; a < 3; ++a)
+            {
+              mean[a] += frame[*u][a] / k;
+            }
+          }
+          if (mover.TryMove(*w, Masked(frame[*w], mean, freeAxes[*w]), true))
+          {
+            relaxed[*w] = 1;
+          }
+        }
+      }
+      const double before = shortfall(i);
+      if (mover.TryMove(v, x[i]) || mover.TryMove(v, Lerp(frame[v], x[i], 0.5)) ||
+        mover.TryMove(v, Lerp(frame[v], x[i], 0.25)))
+      {
+        progressMade += shortfall(i) < before;
+      }
+    }
+    if (!progressMade)
+    {
+      break;
+    }
+  }
+  if (!progress(0.9))
+  {
+    r.Aborted = true;
+    return r;
+  }
+  for (std::int64_t v = 0; v < nPoints; ++v)
+  {
+    r.RelaxedNodes += ring[v] > 0 && (frame[v] != start0[v] || relaxed[v]);
+    r.Points[v] = frame[v] == start0[v] ? mesh.Points()[v] : toIndex(v, frame[v]);
+  }
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    const double d = shortfall(i);
+    r.Shortfall[b.Node[i]] = d;
+    r.ShortNodes += d > tolerance;
+    r.MaxShortfall = std::max(r.MaxShortfall, d);
+  }
+  r.BoundaryPoints = r.Points;
+  r.ObjectMeasureAfter = EnclosedMeasure(frame, r.Faces, faceSize);
+  r.VolumeSeconds = Seconds(start);
+  return r;
+}
+} // namespace featuremesh

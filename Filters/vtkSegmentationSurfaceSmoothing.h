@@ -1,0 +1,84 @@
+/**
+ * @class   vtkSegmentationSurfaceSmoothing
+ * @brief   Smooths a segmentation's boundary and moves its labelled mesh with it (FeatureMesh stage 6).
+ *
+ * Input "Labelled Mesh": the Super-Voxel Cut's first output (triangles or tetrahedra with the cell
+ * array Label, 0 background / 1 object, and the image frame in field data). Output 0: the boundary
+ * between object and background (2D polylines, 3D a closed outward triangle surface) at its smoothed
+ * positions: Laplacian (the thesis, 3 iterations of relaxation 0.5) or Taubin (no shrinkage).
+ * Output 1: the labelled mesh whose nodes followed the boundary, every element positively oriented
+ * and above its quality floor, labels unchanged, quality arrays recomputed and the stale image
+ * statistics dropped; its boundary nodes are output 0's points. Point array Shortfall: how far a
+ * boundary node stopped from its smoothed position. Nodes on the image box stay
+ * on it. See Filters/Core/SurfaceSmoothing.h.
+ */
+#ifndef vtkSegmentationSurfaceSmoothing_h
+#define vtkSegmentationSurfaceSmoothing_h
+
+#include "FeatureMeshFiltersModule.h"
+#include "vtkPolyDataAlgorithm.h"
+
+class FEATUREMESHFILTERS_EXPORT vtkSegmentationSurfaceSmoothing : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkSegmentationSurfaceSmoothing* New();
+  vtkTypeMacro(vtkSegmentationSurfaceSmoothing, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  enum Methods
+  {
+    LAPLACIAN = 0,
+    TAUBIN = 1
+  };
+  /// Laplacian (the thesis, default) or Taubin (lambda|mu: does not shrink).
+  vtkSetClampMacro(Method, int, LAPLACIAN, TAUBIN);
+  vtkGetMacro(Method, int);
+  /// Iterations (default 3, the thesis); Taubin's iteration is one lambda and one mu step.
+  vtkSetMacro(Iterations, int);
+  vtkGetMacro(Iterations, int);
+  /// Relaxation factor lambda (default 0.5, the thesis).
+  vtkSetMacro(Relaxation, double);
+  vtkGetMacro(Relaxation, double);
+  /// Taubin's pass-band frequency (default 0.1): mu = 1 / (PassBand - 1 / Relaxation).
+  vtkSetMacro(PassBand, double);
+  vtkGetMacro(PassBand, double);
+  /// Move the labelled mesh with the boundary (default on); off leaves output 1 as the input.
+  vtkSetMacro(VolumeMesh, bool);
+  vtkGetMacro(VolumeMesh, bool);
+  vtkBooleanMacro(VolumeMesh, bool);
+  /// Quality floors of output 1 (degrees; 2D default 15, 3D default 8); an element already below
+  /// its floor does not get worse.
+  vtkSetMacro(MinAngle, double);
+  vtkGetMacro(MinAngle, double);
+  vtkSetMacro(MinDihedralAngle, double);
+  vtkGetMacro(MinDihedralAngle, double);
+  /// Rings of nodes around the boundary that move with it (default 3).
+  vtkSetMacro(RelaxationRings, int);
+  vtkGetMacro(RelaxationRings, int);
+
+protected:
+  vtkSegmentationSurfaceSmoothing();
+  ~vtkSegmentationSurfaceSmoothing() override = default;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int FillOutputPortInformation(int port, vtkInformation* info) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  // Defaults: featuremesh::SurfaceSmoothingParameters.
+  int Method;
+  int Iterations;
+  double Relaxation;
+  double PassBand;
+  bool VolumeMesh;
+  double MinAngle;
+  double MinDihedralAngle;
+  int RelaxationRings;
+
+private:
+  vtkMTimeType FailedAt = 0;
+  double FailedAtTime = 0.0;
+  vtkSegmentationSurfaceSmoothing(const vtkSegmentationSurfaceSmoothing&) = delete;
+  void operator=(const vtkSegmentationSurfaceSmoothing&) = delete;
+};
+
+#endif
