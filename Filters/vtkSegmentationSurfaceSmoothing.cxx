@@ -7,6 +7,7 @@
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkPointData.h"
 #include "vtkInformation.h"
@@ -92,6 +93,11 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
       return fail("the mesh has no Label cell array; connect the Super-Voxel Cut's first output.");
     }
     ImageGeometry geometry;
+    if (!input->GetFieldData()->GetArray(names::ImageOrigin))
+    {
+      return fail("the mesh's field data hold no image frame (ImageOrigin, ImageSpacing, ImageDimensions, "
+                  "ImageDirection); connect the Super-Voxel Cut's first output, which keeps Delaunay Image Mesh's.");
+    }
     if (!ImageGeometryFromFieldData(input, geometry, error))
     {
       return fail(error);
@@ -130,17 +136,20 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
     // Output 1: the input with its points moved, the stale statistics dropped (the voxels an element
     // owns changed with it), quality recomputed, and the components of each label.
     output->ShallowCopy(input);
-    auto worldPoints = [&](const std::vector<std::array<double, 3>>& index) {
+    // The input's points, the moved ones replaced (unmoved points keep their world coordinates bit
+    // for bit).
+    auto movedPoints = [&](const std::vector<std::array<double, 3>>& index) {
       vtkNew<vtkPoints> points;
       points->SetDataTypeToDouble();
       points->SetNumberOfPoints(static_cast<vtkIdType>(index.size()));
       for (std::size_t i = 0; i < index.size(); ++i)
       {
-        points->SetPoint(static_cast<vtkIdType>(i), geometry.IndexToWorld(index[i]).data());
+        const vtkIdType id = static_cast<vtkIdType>(i);
+        points->SetPoint(id, index[i] != mesh.Points()[i] ? geometry.IndexToWorld(index[i]).data() : input->GetPoint(id));
       }
       return points;
     };
-    vtkNew<vtkPoints> points = worldPoints(result.Points);
+    vtkNew<vtkPoints> points = movedPoints(result.Points);
     output->SetPoints(points);
     const bool is2D = geometry.Is2D();
     for (const char* stale : { names::PixelCount, names::MeanIntensity, names::IntensityStdDev, names::Interpolated })
@@ -181,7 +190,7 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
     output->GetPointData()->AddArray(shortfall);
 
     // Output 0: the boundary, on output 1's points (or at its smoothed positions without VolumeMesh).
-    BoundaryPolyData(par.VolumeMesh ? points.Get() : worldPoints(result.BoundaryPoints).Get(), result.Faces,
+    BoundaryPolyData(par.VolumeMesh ? points.Get() : movedPoints(result.BoundaryPoints).Get(), result.Faces,
       mesh.VerticesPerCell() - 1, boundary);
     boundary->GetPointData()->AddArray(shortfall);
 

@@ -6,6 +6,7 @@
 #include "vtkFeatureNodes.h"
 #include "vtkImageMeshSmoothing.h"
 #include "vtkRSPEdgeEnhancement.h"
+#include "vtkSegmentationSurfaceSmoothing.h"
 #include "vtkSuperVoxelCut.h"
 #include "vtkVoxelCut.h"
 
@@ -1262,4 +1263,175 @@ TEST(RSPEdgeEnhancement, FeedsSeedAwareFeatureNodes)
   rsp->Update();
   FeatureNodes(image, [&](auto& run, vtkPolyData* out) { ExpectNodesInside(run, out, image, 8); }, nullptr,
     vtkImageData::SafeDownCast(rsp->GetOutputDataObject(0)));
+}
+
+namespace
+{
+// The Super-Voxel Cut's labelled mesh of an image (disc or ball, seeds inside and outside).
+vtkSmartPointer<vtkUnstructuredGrid> LabelledMeshOf(vtkImageData* image)
+{
+  vtkSmartPointer<vtkUnstructuredGrid> labelled;
+  SuperVoxelCut(MeshOf(image), ObjectSeeds(image), BackgroundSeeds(image), image,
+    [&](auto&, const CutOutputs& out) { labelled = Copy(out.Mesh.GetPointer()); });
+  return labelled;
+}
+
+template <typename Check>
+void SurfaceSmoothing(vtkUnstructuredGrid* labelled, const Check& check,
+  const std::function<void(vtkSegmentationSurfaceSmoothing*)>& set = nullptr)
+{
+  Run<vtkSegmentationSurfaceSmoothing> run;
+  run->SetInputData(labelled);
+  if (set)
+    set(run.F);
+  run.Update();
+  check(run, run->GetOutput(), vtkUnstructuredGrid::SafeDownCast(run->GetOutputDataObject(1)));
+}
+
+// A good run: no error, the same elements and labels, a boundary with faces, every element positive
+// in world coordinates (the contract's orientation) and above its floor.
+void ExpectSmoothedSurface(Run<vtkSegmentationSurfaceSmoothing>& run, vtkPolyData* surface, vtkUnstructuredGrid* mesh,
+  vtkUnstructuredGrid* labelled)
+{
+  ASSERT_TRUE(run.Log->Errors.empty()) << run.Log->All();
+  ASSERT_EQ(mesh->GetNumberOfCells(), labelled->GetNumberOfCells());
+  EXPECT_GT(surface->GetNumberOfCells(), 0);
+  vtkDataArray* in = labelled->GetCellData()->GetArray("Label");
+  vtkDataArray* out = mesh->GetCellData()->GetArray("Label");
+  ASSERT_NE(out, nullptr);
+  const bool is2D = mesh->GetCellType(0) == VTK_TRIANGLE;
+  vtkDataArray* quality = mesh->GetCellData()->GetArray(is2D ? "MinAngle" : "MinDihedralAngle");
+  ASSERT_NE(quality, nullptr);
+  for (vtkIdType c = 0; c < mesh->GetNumberOfCells(); ++c)
+  {
+    EXPECT_EQ(in->GetComponent(c, 0), out->GetComponent(c, 0));
+    EXPECT_GT(quality->GetComponent(c, 0), 0.0) << c;
+  }
+}
+} // namespace
+
+TEST(SegmentationSurfaceSmoothing, Disc)
+{
+  auto labelled = LabelledMeshOf(Disc());
+  SurfaceSmoothing(labelled, [&](auto& run, vtkPolyData* s, vtkUnstructuredGrid* m) { ExpectSmoothedSurface(run, s, m, labelled); });
+}
+TEST(SegmentationSurfaceSmoothing, BallMirroredAndAnisotropicTaubin)
+{
+  auto image = Ball();
+  const double direction[9] = { -1, 0, 0, 0, 1, 0, 0, 0, 1 };
+  image->SetDirectionMatrix(direction);
+  image->SetSpacing(1.0, 1.5, 2.0);
+  auto labelled = LabelledMeshOf(image);
+  SurfaceSmoothing(labelled, [&](auto& run, vtkPolyData* s, vtkUnstructuredGrid* m) { ExpectSmoothedSurface(run, s, m, labelled); },
+    [](vtkSegmentationSurfaceSmoothing* f) { f->SetMethod(vtkSegmentationSurfaceSmoothing::TAUBIN); });
+}
+TEST(SegmentationSurfaceSmoothing, EverythingObjectSlidesOnTheBox)
+{
+  auto labelled = LabelledMeshOf(Ball());
+  vtkDataArray* label = labelled->GetCellData()->GetArray("Label");
+  for (vtkIdType c = 0; c < label->GetNumberOfTuples(); ++c)
+    label->SetComponent(c, 0, 1);
+  SurfaceSmoothing(labelled, [&](auto& run, vtkPolyData* s, vtkUnstructuredGrid* m) {
+    ExpectSmoothedSurface(run, s, m, labelled);
+    // The boundary is the box: nothing leaves it.
+    double bounds[6], after[6];
+    labelled->GetBounds(bounds);
+    m->GetBounds(after);
+    for (int i = 0; i < 6; ++i)
+      EXPECT_EQ(bounds[i], after[i]);
+  });
+}
+TEST(SegmentationSurfaceSmoothing, NoObjectGivesAnEmptyBoundary)
+{
+  auto labelled = LabelledMeshOf(Disc());
+  vtkDataArray* label = labelled->GetCellData()->GetArray("Label");
+  for (vtkIdType c = 0; c < label->GetNumberOfTuples(); ++c)
+    label->SetComponent(c, 0, 0);
+  SurfaceSmoothing(labelled, [&](auto& run, vtkPolyData* s, vtkUnstructuredGrid* m) {
+    EXPECT_TRUE(run.Log->Errors.empty()) << run.Log->All();
+    EXPECT_EQ(s->GetNumberOfCells(), 0);
+    EXPECT_EQ(m->GetNumberOfCells(), labelled->GetNumberOfCells());
+  });
+}
+TEST(SegmentationSurfaceSmoothing, EmptyMesh)
+{
+  vtkNew<vtkUnstructuredGrid> empty;
+  SurfaceSmoothing(empty, [](auto& run, vtkPolyData* s, vtkUnstructuredGrid*) { ExpectError(run, "empty", s); });
+}
+TEST(SegmentationSurfaceSmoothing, MeshWithoutLabel)
+{
+  auto image = Disc();
+  SurfaceSmoothing(MeshOf(image), [](auto& run, vtkPolyData* s, vtkUnstructuredGrid* m) {
+    ExpectError(run, "no Label cell array", s);
+    EXPECT_EQ(m->GetNumberOfCells(), 0);
+  });
+}
+TEST(SegmentationSurfaceSmoothing, LabelTwoAndNaN)
+{
+  for (const double bad : { 2.0, NaN, -1.0 })
+  {
+    auto labelled = LabelledMeshOf(Disc());
+    vtkNew<vtkDoubleArray> label;
+    label->DeepCopy(labelled->GetCellData()->GetArray("Label"));
+    label->SetComponent(7, 0, bad);
+    labelled->GetCellData()->AddArray(label);
+    SurfaceSmoothing(labelled, [](auto& run, vtkPolyData* s, vtkUnstructuredGrid*) { ExpectError(run, "must be 0", s); });
+  }
+}
+TEST(SegmentationSurfaceSmoothing, LabelWithTwoComponents)
+{
+  auto labelled = LabelledMeshOf(Disc());
+  vtkNew<vtkUnsignedCharArray> label;
+  label->SetName("Label");
+  label->SetNumberOfComponents(2);
+  label->SetNumberOfTuples(labelled->GetNumberOfCells());
+  label->Fill(0);
+  labelled->GetCellData()->AddArray(label);
+  SurfaceSmoothing(labelled, [](auto& run, vtkPolyData* s, vtkUnstructuredGrid*) { ExpectError(run, "no Label cell array", s); });
+}
+TEST(SegmentationSurfaceSmoothing, MeshWithoutItsFrame)
+{
+  auto labelled = LabelledMeshOf(Disc());
+  labelled->GetFieldData()->Initialize();
+  SurfaceSmoothing(labelled, [](auto& run, vtkPolyData* s, vtkUnstructuredGrid*) { ExpectError(run, "ImageOrigin", s); });
+}
+TEST(SegmentationSurfaceSmoothing, QuadMesh)
+{
+  auto labelled = LabelledMeshOf(Disc());
+  vtkNew<vtkCellArray> cells;
+  const vtkIdType q[4] = { 0, 1, 2, 3 };
+  cells->InsertNextCell(4, q);
+  vtkNew<vtkUnstructuredGrid> quads;
+  quads->ShallowCopy(labelled);
+  quads->SetCells(VTK_QUAD, cells);
+  vtkNew<vtkUnsignedCharArray> label;
+  label->SetName("Label");
+  label->InsertNextValue(1);
+  quads->GetCellData()->Initialize();
+  quads->GetCellData()->AddArray(label);
+  SurfaceSmoothing(quads, [](auto& run, vtkPolyData* s, vtkUnstructuredGrid*) { ExpectError(run, "triangles", s); });
+}
+TEST(SegmentationSurfaceSmoothing, BadParameters)
+{
+  auto labelled = LabelledMeshOf(Disc());
+  const std::vector<std::pair<std::function<void(vtkSegmentationSurfaceSmoothing*)>, std::string>> cases = {
+    { [](vtkSegmentationSurfaceSmoothing* f) { f->SetRelaxation(0); }, "Relaxation" },
+    { [](vtkSegmentationSurfaceSmoothing* f) { f->SetRelaxation(NaN); }, "Relaxation" },
+    { [](vtkSegmentationSurfaceSmoothing* f) { f->SetPassBand(5); }, "PassBand" },
+    { [](vtkSegmentationSurfaceSmoothing* f) { f->SetIterations(-1); }, "Iterations" },
+    { [](vtkSegmentationSurfaceSmoothing* f) { f->SetMinDihedralAngle(Inf); }, "MinDihedralAngle" },
+    { [](vtkSegmentationSurfaceSmoothing* f) { f->SetRelaxationRings(1000); }, "RelaxationRings" },
+  };
+  for (const auto& c : cases)
+    SurfaceSmoothing(labelled, [&](auto& run, vtkPolyData* s, vtkUnstructuredGrid*) { ExpectError(run, c.second, s); }, c.first);
+}
+TEST(SegmentationSurfaceSmoothing, ZeroIterationsKeepTheCutsBoundary)
+{
+  auto labelled = LabelledMeshOf(Ball());
+  SurfaceSmoothing(labelled, [&](auto& run, vtkPolyData* s, vtkUnstructuredGrid* m) {
+    ExpectSmoothedSurface(run, s, m, labelled);
+    for (vtkIdType i = 0; i < m->GetNumberOfPoints(); ++i)
+      for (int a = 0; a < 3; ++a)
+        ASSERT_EQ(m->GetPoint(i)[a], labelled->GetPoint(i)[a]);
+  }, [](vtkSegmentationSurfaceSmoothing* f) { f->SetIterations(0); });
 }

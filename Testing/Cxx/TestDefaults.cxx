@@ -4,6 +4,7 @@
 #include "vtkImageMeshSmoothing.h"
 #include "vtkFeatureNodes.h"
 #include "vtkRSPEdgeEnhancement.h"
+#include "vtkSegmentationSurfaceSmoothing.h"
 #include "vtkSuperVoxelCut.h"
 #include "vtkVoxelCut.h"
 
@@ -64,11 +65,15 @@ int main(int argc, char* argv[])
     GETTER(vtkSuperVoxelCut, SuperVoxelIds),
     GETTER(vtkVoxelCut, Lambda), GETTER(vtkVoxelCut, Sigma), GETTER(vtkVoxelCut, Bins),
     GETTER(vtkVoxelCut, SeedRadius), GETTER(vtkVoxelCut, Connectivity), GETTER(vtkVoxelCut, Bandwidth),
+    GETTER(vtkSegmentationSurfaceSmoothing, Method), GETTER(vtkSegmentationSurfaceSmoothing, Iterations),
+    GETTER(vtkSegmentationSurfaceSmoothing, Relaxation), GETTER(vtkSegmentationSurfaceSmoothing, PassBand),
+    GETTER(vtkSegmentationSurfaceSmoothing, VolumeMesh), GETTER(vtkSegmentationSurfaceSmoothing, MinAngle),
+    GETTER(vtkSegmentationSurfaceSmoothing, MinDihedralAngle), GETTER(vtkSegmentationSurfaceSmoothing, RelaxationRings),
   };
   int failures = 0, checked = 0;
   std::set<std::string> seen;
   for (const char* file : { "FeatureNodes.xml", "DelaunayImageMesh.xml", "ImageMeshSmoothing.xml", "RSPEdgeEnhancement.xml",
-         "SuperVoxelCut.xml" })
+         "SuperVoxelCut.xml", "SegmentationSurfaceSmoothing.xml" })
   {
     vtkNew<vtkXMLDataParser> parser;
     const std::string path = std::string(argv[1]) + "/" + file;
