@@ -1,14 +1,20 @@
-"""FeatureMesh main job (pvpython / pvbatch): image + seeds -> [RSP edges ->] nodes -> mesh -> smoothed mesh -> super-voxel cut.
+"""FeatureMesh main job (pvpython / pvbatch): image + seeds -> [RSP edges ->] nodes -> mesh -> smoothed mesh -> super-voxel cut
+-> smoothed segmentation surface and a labelled FEM mesh.
 
 usage: pvpython featuremesh_segment.py IMAGE --object-seeds CSV --background-seeds CSV [--truth LABELS]
                                        [--out DIR] [--plugin FeatureMesh.so]
                                        [--lambda L] [--connectivity off|fill|seeded] [--sigma S] [--bins B]
-                                       [--no-smoothing] [--rsp]
+                                       [--no-smoothing] [--rsp] [--surface-method laplacian|taubin]
+                                       [--surface-iterations N] [--unit mm]
 --rsp runs RSP Edge Enhancement first and feeds its edge map to Feature Nodes (seed-aware nodes: fine
 at the seeded object's boundary, coarse away from it; writes DIR/<name>_edge_confidence.vti too).
 The cut's options default to the Super-Voxel Cut's own defaults (see its properties in ParaView).
 Seeds: CSV files with columns x,y,z in world coordinates, or "x,y,z;x,y,z" on the command line.
-Writes DIR/<name>_mesh.vtu, _boundary.vtp, _labels.vti, _report.json and _view.png.
+Writes DIR/<name>_mesh.vtu (the cut's labelled mesh), _boundary.vtp (the smoothed boundary),
+_labels.vti, _fem.vtu (the labelled mesh with the smoothed interface) and the same mesh for FEM codes:
+_fem.msh (Gmsh 2.2), _fem.mesh (Medit), _fem.inp (Abaqus), _fem.exo (Exodus II), with region and
+boundary tags as python/featuremesh/fem.py lists them; _report.json (also printed), _view.png and
+_quality.png (the quality histogram per label).
 """
 import argparse
 import json
@@ -24,9 +30,10 @@ from vtkmodules.vtkIOXML import vtkXMLImageDataWriter, vtkXMLPolyDataWriter, vtk
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
 import featuremesh as fm  # noqa: E402
-from featuremesh import metrics  # noqa: E402
+from featuremesh import fem, metrics  # noqa: E402
 
 CONNECTIVITY = {"off": "Off", "fill": "Fill Holes", "seeded": "Seeded Object"}
+SURFACE_METHOD = {"laplacian": 0, "taubin": 1}
 
 
 def cells_of(grid):
@@ -51,6 +58,12 @@ def main():
     ap.add_argument("--no-smoothing", action="store_true", help="cut the Delaunay mesh (skip Image Mesh Smoothing)")
     ap.add_argument("--rsp", action="store_true",
                     help="seed-aware nodes: RSP Edge Enhancement's edge map on Feature Nodes' Edge Map input")
+    surface = ap.add_argument_group("Segmentation Surface Smoothing (default: the filter's own defaults)")
+    surface.add_argument("--surface-method", choices=sorted(SURFACE_METHOD),
+                         help="laplacian (the thesis; shrinks) or taubin (keeps the volume)")
+    surface.add_argument("--surface-iterations", type=int, help="smoothing iterations (property Iterations)")
+    ap.add_argument("--unit", default="mm", help="the image spacing's unit, written where a format has a place for it "
+                                                  "(MetaImage and NRRD do not record it; default mm)")
     args = ap.parse_args()
     fm.load_plugin(args.plugin, ns=globals())
     os.makedirs(args.out, exist_ok=True)
@@ -74,16 +87,21 @@ def main():
     cut = SuperVoxelCut(Mesh=mesh, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, **options)
     stages = ([("rsp_edge_enhancement", rsp)] if args.rsp else []) + [("feature_nodes", nodes), ("delaunay_image_mesh", delaunay)]
     stages += [] if args.no_smoothing else [("image_mesh_smoothing", mesh)]
-    for stage, proxy in stages + [("super_voxel_cut", cut)]:
+    surface_options = {name: value for name, value in (("Method", SURFACE_METHOD.get(args.surface_method)),
+                                                       ("Iterations", args.surface_iterations)) if value is not None}
+    smooth = SegmentationSurfaceSmoothing(LabelledMesh=ps.OutputPort(cut, 0), **surface_options)
+    for stage, proxy in stages + [("super_voxel_cut", cut), ("segmentation_surface_smoothing", smooth)]:
         t = time.perf_counter()
         proxy.UpdatePipeline()
         times[stage] = time.perf_counter() - t
-    labelled, boundary, labels = sm.Fetch(cut, idx=0), sm.Fetch(cut, idx=1), sm.Fetch(cut, idx=2)
-    if labelled.GetNumberOfCells() == 0:
+    labelled, labels = sm.Fetch(cut, idx=0), sm.Fetch(cut, idx=2)
+    boundary, fem_mesh = sm.Fetch(smooth, idx=0), sm.Fetch(smooth, idx=1)
+    if labelled.GetNumberOfCells() == 0 or fem_mesh.GetNumberOfCells() == 0:
         raise SystemExit("the pipeline failed; see the errors above")
     for writer, data, suffix in ((vtkXMLUnstructuredGridWriter(), labelled, "_mesh.vtu"),
                                  (vtkXMLPolyDataWriter(), boundary, "_boundary.vtp"),
-                                 (vtkXMLImageDataWriter(), labels, "_labels.vti")):
+                                 (vtkXMLImageDataWriter(), labels, "_labels.vti"),
+                                 (vtkXMLUnstructuredGridWriter(), fem_mesh, "_fem.vtu")):
         writer.SetInputData(data)
         writer.SetFileName(base + suffix)
         writer.Write()
@@ -92,7 +110,13 @@ def main():
         writer.SetInputData(sm.Fetch(rsp))
         writer.SetFileName(base + "_edge_confidence.vti")
         writer.Write()
+    t = time.perf_counter()
+    fem_files = fem.write(fem_mesh, base + "_fem", unit=args.unit)
+    times["fem_export"] = time.perf_counter() - t
     fd = labelled.GetFieldData()
+    sfd = boundary.GetFieldData()
+    smoothing = {sfd.GetArrayName(i): sfd.GetArray(i).GetValue(0) for i in range(sfd.GetNumberOfArrays())
+                 if sfd.GetArray(i).GetNumberOfTuples() == 1}
     field = {fd.GetArrayName(i): fd.GetArray(i).GetValue(0) for i in range(fd.GetNumberOfArrays()) if fd.GetArray(i) is not None}
     quality = v2n(labelled.GetCellData().GetArray("MinAngle") or labelled.GetCellData().GetArray("MinDihedralAngle"))
     raw = sm.Fetch(delaunay)
@@ -109,7 +133,16 @@ def main():
               "sigma": field.get("Sigma"), "flow": field.get("Flow"),
               "object_components": int(field.get("ObjectComponents", 0)),
               # World units (the image spacing's unit, squared in 2D, cubed in 3D), largest first.
-              "object_component_volumes": [float(v) for v in v2n(fd.GetArray("ObjectComponentVolumes"))]}
+              "object_component_volumes": [float(v) for v in v2n(fd.GetArray("ObjectComponentVolumes"))],
+              "surface_smoothing": {"method": smooth.GetProperty("Method").GetData(), "iterations": int(smooth.Iterations),
+                                    "boundary_nodes": int(smoothing["BoundaryNodes"]), "short_nodes": int(smoothing["ShortNodes"]),
+                                    "pinched_nodes": int(smoothing["PinchedNodes"]),
+                                    "max_shortfall": smoothing["MaxShortfall"],
+                                    # Object area (2D) / volume (3D) after / before - 1.
+                                    "measure_change": smoothing["MeasureChange"]},
+              # The labelled mesh with the smoothed interface: per label its elements, measure (world units),
+              # face-connected components and quality histogram; the files and their unit.
+              "fem": dict(fem.report(fem_mesh), unit=args.unit, files=fem_files)}
     if args.truth:
         truth = ps.OpenDataFile(args.truth)
         T = v2n(sm.Fetch(truth).GetPointData().GetScalars()).astype(bool)
@@ -117,6 +150,7 @@ def main():
         report["dice"] = float(fm.dice(L, T))
     with open(base + "_report.json", "w") as f:
         json.dump(report, f, indent=2)
+    quality_picture(report["fem"], "dihedral" if labels.GetDimensions()[2] > 1 else "element", base + "_quality.png")
 
     view = ps.CreateRenderView()
     view.ViewSize = [800, 800]
@@ -128,21 +162,22 @@ def main():
         ps.ColorBy(d, ("POINTS", image.PointData.keys()[0]))
         d.RescaleTransferFunctionToDataRange(False, True)
         ps.GetColorTransferFunction(image.PointData.keys()[0]).ApplyPreset("Grayscale", True)
-        b = ps.Show(ps.OutputPort(cut, 1), view)
+        b = ps.Show(ps.OutputPort(smooth, 0), view)
         b.ColorArrayName = ['POINTS', '']
         b.AmbientColor = b.DiffuseColor = [1.0, 0.2, 0.2]
         b.LineWidth = 2
         b.Position = [0, 0, 1]
     else:
-        b = ps.Show(ps.OutputPort(cut, 1), view)
+        b = ps.Show(ps.OutputPort(smooth, 0), view)
         b.ColorArrayName = ['POINTS', '']
         b.DiffuseColor = [0.85, 0.5, 0.4]
         view.CameraPosition = [1, -2, 1.2]
         view.CameraViewUp = [0, 0, 1]
     view.ResetCamera()
     ps.SaveScreenshot(base + "_view.png", view)
-    for suffix in ("_mesh.vtu", "_boundary.vtp", "_labels.vti", "_report.json", "_view.png"):
+    for suffix in ("_mesh.vtu", "_boundary.vtp", "_labels.vti", "_fem.vtu", "_report.json", "_view.png", "_quality.png"):
         print("wrote", base + suffix)
+    print("wrote", ", ".join(fem_files.values()))
     volumes = report["object_component_volumes"]
     print("stage seconds:", ", ".join("%s %.3f" % kv for kv in times.items()), "| nodes %d, elements %d%s" % (
         report["nodes"], report["elements"], ", Dice %.3f" % report["dice"] if "dice" in report else ""))
@@ -151,6 +186,35 @@ def main():
         "Delaunay" if args.no_smoothing else "smoothed", angles["final"]["min"], angles["final"]["p1"], angles["final"]["max"]))
     print("object: %d component(s), volumes %s%s" % (len(volumes), ", ".join("%.4g" % v for v in volumes[:5]),
                                                     ", ..." if len(volumes) > 5 else ""))
+    ss = report["surface_smoothing"]
+    print("surface smoothing (%s, %d iterations): object %s %+.2f %%, %d of %d boundary nodes short of their smoothed position"
+          % (ss["method"], ss["iterations"], "volume" if dims[2] > 1 else "area", 100 * ss["measure_change"],
+             ss["short_nodes"], ss["boundary_nodes"]))
+    for name, entry in report["fem"]["labels"].items():
+        print("  %-10s %7d elements, %s %.6g %s^%d, %d component(s), smallest %s angle %.2f deg" % (
+            name, entry["elements"], "volume" if dims[2] > 1 else "area", entry["measure"], args.unit,
+            3 if dims[2] > 1 else 2, entry["components"], "dihedral" if dims[2] > 1 else "element", entry["min_quality_degrees"]))
+
+
+def quality_picture(report, kind, path):
+    """Bar chart of the quality histogram of each label (the report's bins)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    bins = report["histogram_bins_degrees"]
+    fig, ax = plt.subplots(figsize=(7, 3.5), dpi=100)
+    width = (bins[1] - bins[0]) / (len(report["labels"]) + 1)
+    for k, (name, entry) in enumerate(report["labels"].items()):
+        ax.bar([b + (k + 0.5) * width for b in bins[:-1]], entry["quality_histogram"], width, label=name)
+    ax.set_yscale("log")
+    ax.set_xlim(0, 90 if kind == "dihedral" else 60)
+    ax.set_xlabel("smallest %s angle of the element (degrees)" % kind)
+    ax.set_ylabel("elements")
+    ax.set_title("Labelled FEM mesh: element quality per label")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
 
 
 if __name__ == "__main__":
