@@ -4,13 +4,16 @@
 #include "vtkImageMeshSmoothing.h"
 #include "vtkFeatureNodes.h"
 #include "vtkRSPEdgeEnhancement.h"
+#include "vtkSegmentationSurfaceSmoothing.h"
 #include "vtkSuperVoxelCut.h"
 
 #include "vtkActor.h"
 #include "vtkLookupTable.h"
+#include "vtkBox.h"
 #include "vtkCamera.h"
 #include "vtkCellArray.h"
 #include "vtkDataSetMapper.h"
+#include "vtkExtractGeometry.h"
 #include "vtkFieldData.h"
 #include "vtkImageActor.h"
 #include "vtkImageData.h"
@@ -123,7 +126,7 @@ int main(int argc, char* argv[])
     return 1;
   }
   const std::string scene = argv[1], data = argv[2];
-  const bool liver = scene.rfind("Liver", 0) == 0;
+  const bool liver = scene.rfind("Liver", 0) == 0 || scene == "SegmentationMesh";
   // DataDir is the bundled data, or one case folder (to draw a shared case by hand).
   const bool oneCase = std::ifstream(data + "/image.mha").good();
   const std::string caseDir = oneCase ? data + "/" : data + (liver ? "/liver-ct-totalseg/" : "/nuclei-dsb2018/");
@@ -292,6 +295,105 @@ int main(int argc, char* argv[])
     }
     ren->ResetCameraClippingRange();
   }
+  else if (scene == "LiverSurfaceSmoothing")
+  {
+    // The cut's boundary (left) and Segmentation Surface Smoothing's (right, the defaults: Laplacian,
+    // the labelled mesh moved with it), on the image-smoothed mesh as the main job runs it.
+    vtkNew<vtkSuperVoxelCut> smoothedCut;
+    smoothedCut->SetInputConnection(0, smoothing->GetOutputPort());
+    smoothedCut->SetInputData(1, ReadSeeds(caseDir + "seeds_object.csv"));
+    smoothedCut->SetInputData(2, ReadSeeds(caseDir + "seeds_background.csv"));
+    smoothedCut->SetInputConnection(3, reader->GetOutputPort());
+    vtkNew<vtkSegmentationSurfaceSmoothing> surface;
+    surface->SetInputConnection(smoothedCut->GetOutputPort(0));
+    win->SetSize(800, 400);
+    ren->SetViewport(0, 0, 0.5, 1);
+    vtkNew<vtkRenderer> right;
+    right->SetBackground(0.1, 0.1, 0.15);
+    right->SetViewport(0.5, 0, 1, 1);
+    right->SetActiveCamera(ren->GetActiveCamera());
+    win->AddRenderer(right);
+    vtkAlgorithmOutput* boundaries[2] = { smoothedCut->GetOutputPort(1), surface->GetOutputPort(0) };
+    vtkRenderer* renderers[2] = { ren, right };
+    for (int side = 0; side < 2; ++side)
+    {
+      vtkNew<vtkPolyDataMapper> mapper;
+      mapper->SetInputConnection(boundaries[side]);
+      mapper->ScalarVisibilityOff();
+      vtkNew<vtkActor> actor;
+      actor->SetMapper(mapper);
+      actor->GetProperty()->SetColor(0.8, 0.45, 0.35);
+      actor->GetProperty()->EdgeVisibilityOn();
+      actor->GetProperty()->SetEdgeColor(0.35, 0.2, 0.15);
+      renderers[side]->AddActor(actor);
+    }
+    ren->ResetCamera();
+    ren->GetActiveCamera()->Elevation(-60);
+    ren->GetActiveCamera()->Azimuth(20);
+    ren->GetActiveCamera()->Zoom(1.1);
+    ren->ResetCameraClippingRange();
+  }
+  else if (scene == "SegmentationMesh")
+  {
+    // The labelled mesh with the smoothed interface (object red, background blue-grey), whole
+    // elements on one side of a plane through the object's centre: the FEM deliverable. DataDir is
+    // one case folder (the baseline is BraTS-0006, from the shared data).
+    vtkNew<vtkSuperVoxelCut> smoothedCut;
+    smoothedCut->SetInputConnection(0, smoothing->GetOutputPort());
+    smoothedCut->SetInputData(1, ReadSeeds(caseDir + "seeds_object.csv"));
+    smoothedCut->SetInputData(2, ReadSeeds(caseDir + "seeds_background.csv"));
+    smoothedCut->SetInputConnection(3, reader->GetOutputPort());
+    vtkNew<vtkSegmentationSurfaceSmoothing> surface;
+    surface->SetInputConnection(smoothedCut->GetOutputPort(0));
+    surface->Update();
+    // The elements within 30 voxels of the object seeds' box (the tumour; the cut's small
+    // components elsewhere stay out of the picture), then those on one side of a plane through
+    // its centre.
+    double bounds[6];
+    ReadSeeds(caseDir + "seeds_object.csv")->GetBounds(bounds);
+    const double margin = 30 * image->GetSpacing()[0];
+    vtkNew<vtkBox> near;
+    near->SetBounds(bounds[0] - margin, bounds[1] + margin, bounds[2] - margin, bounds[3] + margin, bounds[4] - margin,
+      bounds[5] + margin);
+    vtkNew<vtkExtractGeometry> around;
+    around->SetInputConnection(surface->GetOutputPort(1));
+    around->SetImplicitFunction(near);
+    around->ExtractInsideOn();
+    vtkNew<vtkPlane> plane;
+    plane->SetOrigin(0.5 * (bounds[0] + bounds[1]), 0.5 * (bounds[2] + bounds[3]), 0.5 * (bounds[4] + bounds[5]));
+    plane->SetNormal(0, 1, 0);
+    vtkNew<vtkExtractGeometry> half;
+    half->SetInputConnection(around->GetOutputPort());
+    half->SetImplicitFunction(plane);
+    half->ExtractInsideOn();
+    vtkNew<vtkLookupTable> table;
+    table->SetNumberOfTableValues(2);
+    table->SetTableValue(0, 0.45, 0.5, 0.6);
+    table->SetTableValue(1, 0.85, 0.3, 0.25);
+    vtkNew<vtkDataSetMapper> mapper;
+    mapper->SetInputConnection(half->GetOutputPort());
+    mapper->SetScalarModeToUseCellFieldData();
+    mapper->SelectColorArray("Label");
+    mapper->SetColorModeToMapScalars(); // Label is unsigned char: not colours
+    mapper->SetLookupTable(table);
+    mapper->UseLookupTableScalarRangeOff();
+    mapper->SetScalarRange(0, 1);
+    vtkNew<vtkActor> actor;
+    actor->SetMapper(mapper);
+    actor->GetProperty()->EdgeVisibilityOn();
+    actor->GetProperty()->SetEdgeColor(0.1, 0.1, 0.1);
+    ren->AddActor(actor);
+    // The camera looks at the cut face from +y, a little from above.
+    ren->ResetCamera();
+    vtkCamera* camera = ren->GetActiveCamera();
+    camera->SetFocalPoint(plane->GetOrigin());
+    camera->SetPosition(plane->GetOrigin()[0] + 150, plane->GetOrigin()[1] + 300, plane->GetOrigin()[2] + 150);
+    camera->SetViewUp(0, 0, 1);
+    ren->ResetCamera();
+    camera->Zoom(1.3);
+    ren->ResetCameraClippingRange();
+    win->SetSize(600, 500);
+  }
   else if (scene == "NucleiRSP")
   {
     // The thesis's figure set: object marching map, background marching map with the sources (red)
@@ -354,7 +456,8 @@ int main(int argc, char* argv[])
     std::cerr << "unknown scene " << scene << "\n";
     return 1;
   }
-  if (scene != "NucleiSmoothing" && scene != "LiverSmoothing" && scene != "NucleiRSP")
+  if (scene != "NucleiSmoothing" && scene != "LiverSmoothing" && scene != "NucleiRSP" && scene != "LiverSurfaceSmoothing" &&
+    scene != "SegmentationMesh")
   {
     ren->ResetCamera();
   }
