@@ -16,6 +16,7 @@
 #include "vtkObjectFactory.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
 #include "vtkUnstructuredGrid.h"
 
 #include <algorithm>
@@ -134,7 +135,7 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
     }
 
     // Output 1: the input with its points moved, the stale statistics dropped (the voxels an element
-    // owns changed with it), quality recomputed, and the components of each label.
+    // owns changed with it) and the quality recomputed; without VolumeMesh, the input.
     output->ShallowCopy(input);
     // The input's points, the moved ones replaced (unmoved points keep their world coordinates bit
     // for bit).
@@ -149,13 +150,7 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
       }
       return points;
     };
-    vtkNew<vtkPoints> points = movedPoints(result.Points);
-    output->SetPoints(points);
     const bool is2D = geometry.Is2D();
-    for (const char* stale : { names::PixelCount, names::MeanIntensity, names::IntensityStdDev, names::Interpolated })
-    {
-      output->GetCellData()->RemoveArray(stale);
-    }
     // The smallest angle before: the input's quality array (stages 2 and 3 write it), else computed.
     const char* qualityName = is2D ? names::MinAngle : names::MinDihedralAngle;
     std::vector<double> minAngle, radiusRatio;
@@ -169,18 +164,28 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
       ElementQuality(mesh, minAngle, radiusRatio, parallel);
       before = *std::min_element(minAngle.begin(), minAngle.end());
     }
-    SimplexMesh moved = mesh;
-    moved.SetPoints(result.Points);
-    ElementQuality(moved, minAngle, radiusRatio, parallel);
-    const double after = *std::min_element(minAngle.begin(), minAngle.end());
-    for (const auto& array : { std::make_pair(qualityName, &minAngle),
-           std::make_pair(names::RadiusRatio, &radiusRatio) })
+    double after = before;
+    vtkSmartPointer<vtkPoints> points = input->GetPoints();
+    if (par.VolumeMesh)
     {
-      vtkNew<vtkDoubleArray> values;
-      values->SetName(array.first);
-      values->SetNumberOfTuples(nCells);
-      std::copy(array.second->begin(), array.second->end(), values->GetPointer(0));
-      output->GetCellData()->AddArray(values);
+      points = movedPoints(result.Points);
+      output->SetPoints(points);
+      for (const char* stale : { names::PixelCount, names::MeanIntensity, names::IntensityStdDev, names::Interpolated })
+      {
+        output->GetCellData()->RemoveArray(stale);
+      }
+      SimplexMesh moved = mesh;
+      moved.SetPoints(result.Points);
+      ElementQuality(moved, minAngle, radiusRatio, parallel);
+      after = *std::min_element(minAngle.begin(), minAngle.end());
+      for (const auto& array : { std::make_pair(qualityName, &minAngle), std::make_pair(names::RadiusRatio, &radiusRatio) })
+      {
+        vtkNew<vtkDoubleArray> values;
+        values->SetName(array.first);
+        values->SetNumberOfTuples(nCells);
+        std::copy(array.second->begin(), array.second->end(), values->GetPointer(0));
+        output->GetCellData()->AddArray(values);
+      }
     }
     output->GetCellData()->SetActiveScalars(names::Label);
     vtkNew<vtkFloatArray> shortfall;
@@ -202,6 +207,7 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
       AddFieldValue(d, names::NonManifoldEdges, static_cast<double>(result.NonManifoldEdges));
       AddFieldValue(d, names::ShortNodes, static_cast<double>(result.ShortNodes));
       AddFieldValue(d, names::MaxShortfall, result.MaxShortfall);
+      AddFieldValue(d, names::ReachedFraction, result.ReachedFraction);
       AddFieldValue(d, names::RelaxedNodes, static_cast<double>(result.RelaxedNodes));
       AddFieldValue(d, names::ObjectMeasureBefore, result.ObjectMeasureBefore);
       AddFieldValue(d, names::ObjectMeasureAfter, result.ObjectMeasureAfter);

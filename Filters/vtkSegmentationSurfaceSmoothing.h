@@ -52,7 +52,7 @@ public:
   vtkGetMacro(MinAngle, double);
   vtkSetMacro(MinDihedralAngle, double);
   vtkGetMacro(MinDihedralAngle, double);
-  /// Rings of nodes around the boundary that move with it (default 3).
+  /// Rings of nodes around the boundary that move with it (default 2).
   vtkSetMacro(RelaxationRings, int);
   vtkGetMacro(RelaxationRings, int);
 

@@ -90,6 +90,7 @@ constexpr const char* PinchedNodes = "PinchedNodes";         // non-manifold bou
 constexpr const char* NonManifoldEdges = "NonManifoldEdges"; // 3D boundary edges of other than two faces
 constexpr const char* ShortNodes = "ShortNodes";             // boundary nodes short of their smoothed position
 constexpr const char* MaxShortfall = "MaxShortfall";         // world units
+constexpr const char* ReachedFraction = "ReachedFraction";   // 1 - summed shortfall / summed smoothing displacement
 constexpr const char* RelaxedNodes = "RelaxedNodes";
 constexpr const char* ObjectMeasureBefore = "ObjectMeasureBefore"; // object area (2D) / volume (3D), world units
 constexpr const char* ObjectMeasureAfter = "ObjectMeasureAfter";

@@ -56,12 +56,13 @@ struct Boundary
 {
   std::vector<std::int64_t> Node;  // local -> mesh point id
   std::vector<std::int64_t> Faces; // local ids, vpc - 1 per face
-  CompressedRows Neighbours;
+  // Neighbours over all faces, and over the interface faces alone (the first `interfaceFaces`).
+  CompressedRows Neighbours, InterfaceNeighbours;
   std::vector<std::uint8_t> Pinched;
   std::int64_t NonManifoldEdges = 0;
 };
 
-Boundary BoundaryGraph(std::int64_t nPoints, const std::vector<std::int64_t>& faces, int faceSize)
+Boundary BoundaryGraph(std::int64_t nPoints, const std::vector<std::int64_t>& faces, int faceSize, std::int64_t interfaceFaces)
 {
   Boundary b;
   std::vector<std::int64_t> local(nPoints, -1);
@@ -97,6 +98,8 @@ Boundary BoundaryGraph(std::int64_t nPoints, const std::vector<std::int64_t>& fa
       b.Pinched[i] = degree[i] != 2;
     }
     b.Neighbours = RowsFromPairs(n, pairs);
+    pairs.resize(2 * interfaceFaces);
+    b.InterfaceNeighbours = RowsFromPairs(n, pairs);
     return b;
   }
   // 3D: directed edges a -> c of the faces (each face's three, in its orientation).
@@ -172,6 +175,8 @@ Boundary BoundaryGraph(std::int64_t nPoints, const std::vector<std::int64_t>& fa
     b.Pinched[v] = !(x == next.begin()->first && steps == star.Size(v) && static_cast<std::int64_t>(next.size()) == steps);
   }
   b.Neighbours = RowsFromPairs(n, pairs);
+  pairs.resize(6 * interfaceFaces);
+  b.InterfaceNeighbours = RowsFromPairs(n, pairs);
   return b;
 }
 
@@ -358,18 +363,26 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
   }
 
   // The boundary's targets.
-  const Boundary b = BoundaryGraph(mesh.NumberOfPoints(), r.Faces, faceSize);
+  const Boundary b = BoundaryGraph(mesh.NumberOfPoints(), r.Faces, faceSize, r.InterfaceFaces);
   const std::int64_t n = static_cast<std::int64_t>(b.Node.size());
   r.BoundaryNodes = n;
   r.NonManifoldEdges = b.NonManifoldEdges;
   const std::vector<std::uint8_t> freeAxes = FreeAxes(mesh, std::vector<std::uint8_t>());
   std::vector<std::uint8_t> axes(n);
   std::vector<V3> x(n), next(n);
+  // A node where the interface meets the image box averages its interface neighbours only: the
+  // object's faces on the box would pull the rim inwards (a free-boundary condition instead).
+  const std::uint8_t allAxes = faceSize == 2 ? 3 : 7;
+  std::vector<const CompressedRows*> rows(n, &b.Neighbours);
   for (std::int64_t i = 0; i < n; ++i)
   {
     axes[i] = b.Pinched[i] ? 0 : freeAxes[b.Node[i]];
     r.PinchedNodes += b.Pinched[i];
     x[i] = frame[b.Node[i]];
+    if (axes[i] && axes[i] != allAxes && b.InterfaceNeighbours.Size(i) > 0)
+    {
+      rows[i] = &b.InterfaceNeighbours;
+    }
   }
   std::vector<double> factors{ p.Relaxation };
   if (p.Method == SurfaceSmoothingMethod::Taubin)
@@ -384,13 +397,14 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
         for (std::int64_t i = begin; i < end; ++i)
         {
           next[i] = x[i];
-          const std::int64_t k = b.Neighbours.Size(i);
+          const CompressedRows& around = *rows[i];
+          const std::int64_t k = around.Size(i);
           if (!axes[i] || k == 0)
           {
             continue;
           }
           V3 mean = { { 0, 0, 0 } };
-          for (const std::int64_t* j = b.Neighbours.Begin(i); j != b.Neighbours.End(i); ++j)
+          for (const std::int64_t* j = around.Begin(i); j != around.End(i); ++j)
           {
             for (int a = 0; a < 3; ++a)
             {
@@ -541,8 +555,8 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
   {
     target[v] = ring[v] < 0 ? frame[v] : V3{ { frame[v][0] + move[v][0], frame[v][1] + move[v][1], frame[v][2] + move[v][2] } };
   }
-  // Steps along the moves, boundary first, then ring by ring; a node that cannot take a step
-  // tries half of it.
+  // Passes over the boundary, then ring by ring: a node moves the whole way when its star allows
+  // it, else to the pass's step along its move, else half-way there.
   const int steps = 4;
   for (int s = 1; s <= steps; ++s)
   {
@@ -551,12 +565,12 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
     {
       for (const std::int64_t v : nodes)
       {
-        if (target[v] == start0[v])
+        if (frame[v] == target[v] || mover.TryMove(v, target[v]))
         {
           continue;
         }
         const V3 to = Lerp(start0[v], target[v], t);
-        if (!mover.TryMove(v, to))
+        if (s == steps || !mover.TryMove(v, to))
         {
           mover.TryMove(v, Lerp(frame[v], to, 0.5));
         }
@@ -632,13 +646,17 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
     r.RelaxedNodes += ring[v] > 0 && (frame[v] != start0[v] || relaxed[v]);
     r.Points[v] = frame[v] == start0[v] ? mesh.Points()[v] : toIndex(v, frame[v]);
   }
+  double total = 0.0, missed = 0.0;
   for (std::int64_t i = 0; i < n; ++i)
   {
     const double d = shortfall(i);
+    total += Norm(Sub(x[i], start0[b.Node[i]]));
+    missed += d;
     r.Shortfall[b.Node[i]] = d;
     r.ShortNodes += d > tolerance;
     r.MaxShortfall = std::max(r.MaxShortfall, d);
   }
+  r.ReachedFraction = total > 0 ? 1.0 - missed / total : 1.0;
   r.BoundaryPoints = r.Points;
   r.ObjectMeasureAfter = EnclosedMeasure(frame, r.Faces, faceSize);
   r.VolumeSeconds = Seconds(start);

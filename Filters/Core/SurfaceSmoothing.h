@@ -6,7 +6,9 @@
 // points. Its nodes move by Laplacian smoothing (thesis 4.4: 3 iterations, relaxation 0.5) or by
 // Taubin's lambda|mu smoothing, which does not shrink. Uniform weights over the boundary
 // neighbours, in frame coordinates (index x |spacing|), Jacobi updates. A node on the image box
-// moves only within its box face or edge; box corners never move. A node where the boundary is not
+// moves only within its box face or edge; box corners never move. Where the interface meets the box
+// a node averages its interface neighbours only (the object's faces on the box would pull the rim
+// inwards). A node where the boundary is not
 // a manifold (3D: an edge of more or fewer than two faces, or a vertex whose faces form several
 // fans; 2D: a vertex of other than two edges) is a pinch between two parts of the object and stays.
 //
@@ -50,7 +52,7 @@ struct SurfaceSmoothingParameters
   double MinAngle = 15.0;
   double MinDihedralAngle = 8.0;
   // Rings of nodes around the boundary that move with it.
-  int RelaxationRings = 3;
+  int RelaxationRings = 2;
 };
 
 // Empty when usable, else a sentence naming the bad parameter.
@@ -71,6 +73,8 @@ struct SurfaceSmoothingResult
   // boundary), and the largest.
   std::vector<double> Shortfall;
   double MaxShortfall = 0.0;
+  // 1 - (summed shortfall) / (summed smoothing displacement): how much of the smoothing the mesh took.
+  double ReachedFraction = 1.0;
   // Object measure (area 2D, volume 3D; world units) before and after.
   double ObjectMeasureBefore = 0.0, ObjectMeasureAfter = 0.0;
   double SurfaceSeconds = 0.0, VolumeSeconds = 0.0;

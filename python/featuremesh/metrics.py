@@ -293,3 +293,24 @@ def mask_surface(image, scalars):
     fe.ComputeNormalsOff()
     fe.Update()
     return fe.GetOutput()
+
+
+def without_box_faces(surface, bounds, tolerance=1e-6):
+    """The triangles of `surface` that do not lie in a plane of the box `bounds` (xmin, xmax, ymin, ...):
+    the object's interface without its caps on the image box (where the reference's iso-surface is open)."""
+    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+    from vtkmodules.util.numpy_support import numpy_to_vtkIdTypeArray
+    P = v2n(surface.GetPoints().GetData()).astype(float)
+    F = v2n(surface.GetPolys().GetConnectivityArray()).reshape(-1, 3)
+    on_box = np.zeros(len(F), bool)
+    for axis in range(3):
+        for bound in bounds[2 * axis: 2 * axis + 2]:
+            on_box |= (np.abs(P[F, axis] - bound) <= tolerance * max(1.0, abs(bound))).all(axis=1)
+    kept = F[~on_box]
+    cells = vtkCellArray()
+    cells.SetData(numpy_to_vtkIdTypeArray(np.arange(0, 3 * len(kept) + 1, 3, dtype=np.int64), deep=1),
+                  numpy_to_vtkIdTypeArray(kept.ravel().astype(np.int64), deep=1))
+    out = vtkPolyData()
+    out.SetPoints(surface.GetPoints())
+    out.SetPolys(cells)
+    return out
