@@ -4,7 +4,8 @@ usage: pvpython scripts/digest.py [--cases a,b] [--out FILE] [--cut Lambda=1,Con
 For each case (bundled Data/ and ../shared/data/cases) prints one line per output: the SHA-256 of
 the node points and arrays, of the mesh (points, cells, every cell array by value), of the
 smoothed mesh (stage 3 at its defaults, default backend), of the
-super-voxel labels (cells and label image) and of the voxel cut's labels, at the default
+super-voxel labels (cells and label image), of Segmentation Surface Smoothing's output (the labelled
+mesh's points and the boundary's faces) and of the voxel cut's labels, at the default
 properties (--cut overrides properties of both cuts, e.g. the defaults of an older commit); 3D cases
 also with the CGAL backend. Compare two runs with diff.
 """
@@ -60,6 +61,10 @@ def main():
             cut = case.super_voxel_cut(mesh, **cut_properties)
             lines.append("%s labels %s" % (tag, sha(fm.v2n(fm.fetch(cut, 0).GetCellData().GetArray("Label")),
                                                     fm.v2n(fm.fetch(cut, 2).GetPointData().GetScalars()))))
+            surface = case.surface_smoothing(cut)
+            f0, f1 = fm.fetch(surface, 0), fm.fetch(surface, 1)
+            faces = f0.GetPolys() if f0.GetNumberOfPolys() else f0.GetLines()
+            lines.append("%s surface %s" % (tag, sha(fm.v2n(f1.GetPoints().GetData()), fm.v2n(faces.GetConnectivityArray()))))
             if backend == 0:
                 smoothed = case.smoothing(mesh)
                 s = fm.fetch(smoothed)

@@ -10,7 +10,8 @@ try:
     import paraview.simple as ps
 
     pxm = sm.vtkSMProxyManager.GetProxyManager().GetActiveSessionProxyManager()
-    names = ("FeatureNodes", "DelaunayImageMesh", "SuperVoxelCut", "VoxelCut")
+    names = ("FeatureNodes", "DelaunayImageMesh", "ImageMeshSmoothing", "RSPEdgeEnhancement", "SuperVoxelCut", "VoxelCut",
+             "SegmentationSurfaceSmoothing")
     missing = [n for n in names if not pxm.GetPrototypeProxy("filters", n)]
     lines.append(("FAIL: missing filters %s" % missing) if missing else "ok: the FeatureMesh filters are loaded")
     if not missing:
@@ -31,7 +32,8 @@ try:
             return ok
 
         for filter_name, selected, what in (("FeatureNodes", image, "the image"), ("DelaunayImageMesh", nodes, "the nodes"),
-                                            ("SuperVoxelCut", mesh, "the mesh"), ("VoxelCut", image, "the image")):
+                                            ("SuperVoxelCut", mesh, "the mesh"), ("VoxelCut", image, "the image"),
+                                            ("SegmentationSurfaceSmoothing", mesh, "a mesh")):
             ok = enabled(filter_name, selected)
             lines.append("%s: %s is enabled with %s selected" % ("ok" if ok else "FAIL", filter_name, what))
         lines.append(("ok" if enabled("DelaunayImageMesh", image) is False else "FAIL") +

@@ -15,4 +15,5 @@ for name in ("nuclei-dsb2018", "liver-ct-totalseg"):
     cut.UpdatePipeline()
     ps.SaveData(os.path.join(out, name + "_labelled.pvtu"), proxy=ps.OutputPort(cut, 0))
     ps.SaveData(os.path.join(out, name + "_labels.pvti"), proxy=ps.OutputPort(cut, 2))
+    ps.SaveData(os.path.join(out, name + "_fem.pvtu"), proxy=ps.OutputPort(c.surface_smoothing(cut), 1))
     ps.SaveData(os.path.join(out, name + "_voxelcut.pvti"), proxy=c.voxel_cut())

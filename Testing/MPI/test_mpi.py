@@ -39,6 +39,13 @@ for name in ("nuclei-dsb2018", "liver-ct-totalseg"):
     saved = r.GetOutput().GetCellData().GetArray("Label")
     ft.check(saved is not None and ft.np.array_equal(ft.v2n(saved), ft.array(ft.fetch(cut), "Label", cells=True)),
              "%s: the parallel run's element labels equal the serial run's" % name)
+    r = vtkXMLPUnstructuredGridReader()
+    r.SetFileName(os.path.join(out, name + "_fem.pvtu"))
+    r.Update()
+    serial = ft.fetch(c.surface_smoothing(cut), 1)
+    ft.check(r.GetOutput().GetNumberOfPoints() == serial.GetNumberOfPoints() and
+             ft.np.array_equal(ft.v2n(r.GetOutput().GetPoints().GetData()), ft.v2n(serial.GetPoints().GetData())),
+             "%s: the parallel run's smoothed labelled mesh equals the serial run's" % name)
     for suffix, proxy, port in (("_labels.pvti", cut, 2), ("_voxelcut.pvti", vc, 0)):
         ri = vtkXMLPImageDataReader()
         ri.SetFileName(os.path.join(out, name + suffix))

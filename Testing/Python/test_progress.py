@@ -1,5 +1,6 @@
 """Progress and abort on the largest case (BraTS, 240x240x155): every filter reports progress at
-least every 0.5 s; an abort during the max-flow (or the smoothing's TetGen refinement, or RSP's paths) returns within
+least every 0.5 s; an abort during the max-flow (or the smoothing's TetGen refinement, RSP's paths, or the
+volume mesh following the smoothed boundary) returns within
 a second with an empty output; the aborted filter runs again on the next update and gives its full
 result."""
 import time
@@ -29,7 +30,8 @@ smoothed = case.smoothing(mesh)
 cut = case.super_voxel_cut(mesh)
 for name, proxy in (("Feature Nodes", nodes), ("Delaunay Image Mesh", mesh), ("Image Mesh Smoothing", smoothed),
                     ("Super-Voxel Cut", cut), ("Voxel Cut", case.voxel_cut()), ("RSP Edge Enhancement", case.rsp()),
-                    ("RSP Edge Enhancement at full resolution", case.rsp(MaximumPathVoxels=0))):
+                    ("RSP Edge Enhancement at full resolution", case.rsp(MaximumPathVoxels=0)),
+                    ("Segmentation Surface Smoothing", case.surface_smoothing(cut))):
     gap, events, seconds = watch(proxy)
     ft.check(gap <= MAX_GAP, "%s on BraTS: %d progress events over %.2f s, longest gap %.3f s (<= %.1f s)" % (name, events, seconds, gap, MAX_GAP))
 
@@ -89,3 +91,11 @@ ft.check(after is not None and after < 1.0, "RSP Edge Enhancement returns %.2f s
 ft.check(empty, "an aborted RSP Edge Enhancement has an empty output")
 rsp.UpdatePipeline()
 ft.check(ft.array(ft.fetch(rsp), "EdgeConfidence").max() > 0, "and runs again on the next update")
+
+# Segmentation Surface Smoothing, aborted while the labelled mesh follows the boundary.
+ss = case.surface_smoothing(cut)
+after, empty = abort_after(ss, 0.3)
+ft.check(after is not None and after < 1.0, "Segmentation Surface Smoothing returns %.2f s after an abort (< 1 s)" % (after or -1))
+ft.check(empty, "an aborted Segmentation Surface Smoothing has an empty output")
+ss.UpdatePipeline()
+ft.check(ft.fetch(ss).GetNumberOfCells() > 0 and ft.fetch(ss, 1).GetNumberOfCells() > 0, "and runs again on the next update")
