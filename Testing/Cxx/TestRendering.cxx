@@ -107,6 +107,20 @@ void AddPoints(vtkRenderer* ren, vtkPolyData* points, double r, double g, double
   ren->AddActor(actor);
 }
 
+// Halves the window: `ren` on the left, a new renderer with the same camera on the right (returned;
+// the window holds it).
+vtkRenderer* SideBySide(vtkRenderWindow* win, vtkRenderer* ren)
+{
+  win->SetSize(800, 400);
+  ren->SetViewport(0, 0, 0.5, 1);
+  vtkNew<vtkRenderer> right;
+  right->SetBackground(0.1, 0.1, 0.15);
+  right->SetViewport(0.5, 0, 1, 1);
+  right->SetActiveCamera(ren->GetActiveCamera());
+  win->AddRenderer(right);
+  return right;
+}
+
 void AddImage(vtkRenderer* ren, vtkImageData* image, double window, double level)
 {
   vtkNew<vtkImageActor> actor;
@@ -149,6 +163,14 @@ int main(int argc, char* argv[])
   cut->SetInputData(1, ReadSeeds(caseDir + "seeds_object.csv"));
   cut->SetInputData(2, ReadSeeds(caseDir + "seeds_background.csv"));
   cut->SetInputConnection(3, reader->GetOutputPort());
+  // The main job's cut (on the smoothed mesh) and Segmentation Surface Smoothing of it.
+  vtkNew<vtkSuperVoxelCut> smoothedCut;
+  smoothedCut->SetInputConnection(0, smoothing->GetOutputPort());
+  smoothedCut->SetInputData(1, ReadSeeds(caseDir + "seeds_object.csv"));
+  smoothedCut->SetInputData(2, ReadSeeds(caseDir + "seeds_background.csv"));
+  smoothedCut->SetInputConnection(3, reader->GetOutputPort());
+  vtkNew<vtkSegmentationSurfaceSmoothing> surface;
+  surface->SetInputConnection(smoothedCut->GetOutputPort(0));
 
   vtkNew<vtkRenderer> ren;
   ren->SetBackground(0.1, 0.1, 0.15);
@@ -234,13 +256,7 @@ int main(int argc, char* argv[])
   {
     // Before (left) and after (right) Image Mesh Smoothing: a nuclei close-up coloured by the
     // elements' mean intensity, the liver clipped and coloured by the minimum dihedral angle.
-    win->SetSize(800, 400);
-    ren->SetViewport(0, 0, 0.5, 1);
-    vtkNew<vtkRenderer> right;
-    right->SetBackground(0.1, 0.1, 0.15);
-    right->SetViewport(0.5, 0, 1, 1);
-    right->SetActiveCamera(ren->GetActiveCamera());
-    win->AddRenderer(right);
+    vtkRenderer* right = SideBySide(win, ren);
     vtkNew<vtkPlane> plane;
     plane->SetOrigin(180, 150, 45);
     plane->SetNormal(0, 0, 1);
@@ -299,20 +315,7 @@ int main(int argc, char* argv[])
   {
     // The cut's boundary (left) and Segmentation Surface Smoothing's (right, the defaults: Laplacian,
     // the labelled mesh moved with it), on the image-smoothed mesh as the main job runs it.
-    vtkNew<vtkSuperVoxelCut> smoothedCut;
-    smoothedCut->SetInputConnection(0, smoothing->GetOutputPort());
-    smoothedCut->SetInputData(1, ReadSeeds(caseDir + "seeds_object.csv"));
-    smoothedCut->SetInputData(2, ReadSeeds(caseDir + "seeds_background.csv"));
-    smoothedCut->SetInputConnection(3, reader->GetOutputPort());
-    vtkNew<vtkSegmentationSurfaceSmoothing> surface;
-    surface->SetInputConnection(smoothedCut->GetOutputPort(0));
-    win->SetSize(800, 400);
-    ren->SetViewport(0, 0, 0.5, 1);
-    vtkNew<vtkRenderer> right;
-    right->SetBackground(0.1, 0.1, 0.15);
-    right->SetViewport(0.5, 0, 1, 1);
-    right->SetActiveCamera(ren->GetActiveCamera());
-    win->AddRenderer(right);
+    vtkRenderer* right = SideBySide(win, ren);
     vtkAlgorithmOutput* boundaries[2] = { smoothedCut->GetOutputPort(1), surface->GetOutputPort(0) };
     vtkRenderer* renderers[2] = { ren, right };
     for (int side = 0; side < 2; ++side)
@@ -338,13 +341,6 @@ int main(int argc, char* argv[])
     // The labelled mesh with the smoothed interface (object red, background blue-grey), whole
     // elements on one side of a plane through the object's centre: the FEM deliverable. DataDir is
     // one case folder (the baseline is BraTS-0006, from the shared data).
-    vtkNew<vtkSuperVoxelCut> smoothedCut;
-    smoothedCut->SetInputConnection(0, smoothing->GetOutputPort());
-    smoothedCut->SetInputData(1, ReadSeeds(caseDir + "seeds_object.csv"));
-    smoothedCut->SetInputData(2, ReadSeeds(caseDir + "seeds_background.csv"));
-    smoothedCut->SetInputConnection(3, reader->GetOutputPort());
-    vtkNew<vtkSegmentationSurfaceSmoothing> surface;
-    surface->SetInputConnection(smoothedCut->GetOutputPort(0));
     surface->Update();
     // The elements within 30 voxels of the object seeds' box (the tumour; the cut's small
     // components elsewhere stay out of the picture), then those on one side of a plane through
