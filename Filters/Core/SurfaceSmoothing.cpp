@@ -586,7 +586,6 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
   // their star's quality), then they try again.
   auto shortfall = [&](std::int64_t i) { return Norm(Sub(frame[b.Node[i]], x[i])); };
   const double tolerance = 1e-9 * std::max({ std::fabs(g.Spacing[0]), std::fabs(g.Spacing[1]), std::fabs(g.Spacing[2]) });
-  std::vector<std::uint8_t> relaxed(nPoints, 0);
   for (int round = 0; round < 3; ++round)
   {
     std::vector<std::int64_t> stuck;
@@ -618,10 +617,7 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
               mean[a] += frame[*u][a] / k;
             }
           }
-          if (mover.TryMove(*w, Masked(frame[*w], mean, freeAxes[*w]), true))
-          {
-            relaxed[*w] = 1;
-          }
+          mover.TryMove(*w, Masked(frame[*w], mean, freeAxes[*w]), true);
         }
       }
       const double before = shortfall(i);
@@ -643,7 +639,7 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
   }
   for (std::int64_t v = 0; v < nPoints; ++v)
   {
-    r.RelaxedNodes += ring[v] > 0 && (frame[v] != start0[v] || relaxed[v]);
+    r.RelaxedNodes += ring[v] > 0 && frame[v] != start0[v];
     r.Points[v] = frame[v] == start0[v] ? mesh.Points()[v] : toIndex(v, frame[v]);
   }
   double total = 0.0, missed = 0.0;
