@@ -28,6 +28,32 @@
 
 vtkStandardNewMacro(vtkSuperVoxelCut);
 
+struct vtkSuperVoxelCut::MeshData
+{
+  // The inputs they came from: the same objects, unmodified since (the data objects' own MTime
+  // moves with every pipeline pass, so the arrays are compared).
+  std::vector<std::pair<vtkObject*, vtkMTimeType>> Sources;
+  featuremesh::ImageGeometry Frame;
+  featuremesh::SimplexMesh Mesh;
+  std::vector<double> Mean, Count, Values;
+  std::vector<std::int64_t> Owner;
+
+  MeshData(std::initializer_list<vtkObject*> sources, const featuremesh::ImageGeometry& frame)
+    : Frame(frame)
+  {
+    for (vtkObject* o : sources)
+    {
+      this->Sources.emplace_back(o, o ? o->GetMTime() : 0);
+    }
+  }
+  bool SameInputs(const MeshData& other) const
+  {
+    return this->Sources == other.Sources && featuremesh::SameFrame(this->Frame, other.Frame);
+  }
+};
+
+vtkSuperVoxelCut::~vtkSuperVoxelCut() = default;
+
 vtkSuperVoxelCut::vtkSuperVoxelCut()
 {
   const featuremesh::SuperVoxelCutParameters defaults;
@@ -146,50 +172,71 @@ int vtkSuperVoxelCut::RequestData(
     {
       return fail(error);
     }
-    SimplexMesh mesh;
-    if (!ToSimplexMesh(input, geometry, mesh, error))
+    vtkDataArray* valuesArray = nullptr;
+    if (image)
     {
-      return fail(error);
+      valuesArray = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
+      if (!warning.empty())
+      {
+        vtkWarningMacro("Super-Voxel Cut: " << warning);
+      }
+      if (!valuesArray)
+      {
+        return fail(error);
+      }
     }
+    // The mesh-dependent data: kept from the last run when the mesh, the image and its array are
+    // the same objects, unmodified (a seed edit).
+    const MeshData key({ input->GetPoints(), input->GetCells(), meanArray, countArray, valuesArray }, geometry);
+    if (!this->Prepared || !this->Prepared->SameInputs(key))
+    {
+      this->Prepared.reset();
+      auto prepared = std::make_unique<MeshData>(key);
+      if (!ToSimplexMesh(input, geometry, prepared->Mesh, error))
+      {
+        return fail(error);
+      }
+      const vtkIdType nCells = input->GetNumberOfCells();
+      prepared->Mean.resize(nCells);
+      prepared->Count.resize(nCells);
+      vtkIdType badMean = 0, badCount = 0;
+      for (vtkIdType c = 0; c < nCells; ++c)
+      {
+        const double mean = prepared->Mean[c] = meanArray->GetComponent(c, 0);
+        const double count = prepared->Count[c] = countArray->GetComponent(c, 0);
+        badMean += std::isfinite(mean) ? 0 : 1;
+        badCount += std::isfinite(count) && count >= 0 ? 0 : 1;
+      }
+      if (badMean || badCount)
+      {
+        return fail("the mesh's " + std::string(badMean ? "MeanIntensity" : "PixelCount") + " cell array holds " +
+          std::to_string(badMean ? badMean : badCount) +
+          (badMean ? " NaN or infinite values" : " negative or non-finite values") + "; recompute the mesh with Delaunay Image Mesh.");
+      }
+      if (valuesArray && !ToDouble(valuesArray, prepared->Values, error))
+      {
+        return fail(error);
+      }
+      this->UpdateProgress(0.1);
+      prepared->Owner = VoxelOwners(ElementRasterizer(prepared->Mesh), SMPParallelFor(), AlgorithmProgress(this, 0.1, 0.4));
+      if (prepared->Owner.empty())
+      {
+        return 1; // aborted
+      }
+      this->Prepared = std::move(prepared);
+    }
+    const MeshData& data = *this->Prepared;
+    const SimplexMesh& mesh = data.Mesh;
     std::vector<std::int64_t> objectVoxels, backgroundVoxels;
     if (!ObjectAndBackgroundVoxels(objectSeeds, backgroundSeeds, geometry, objectVoxels, backgroundVoxels, error))
     {
       return fail(error);
     }
     const vtkIdType nCells = input->GetNumberOfCells();
-    std::vector<double> mean(nCells), count(nCells);
-    vtkIdType badMean = 0, badCount = 0;
-    for (vtkIdType c = 0; c < nCells; ++c)
-    {
-      mean[c] = meanArray->GetComponent(c, 0);
-      count[c] = countArray->GetComponent(c, 0);
-      badMean += std::isfinite(mean[c]) ? 0 : 1;
-      badCount += std::isfinite(count[c]) && count[c] >= 0 ? 0 : 1;
-    }
-    if (badMean || badCount)
-    {
-      return fail("the mesh's " + std::string(badMean ? "MeanIntensity" : "PixelCount") + " cell array holds " +
-        std::to_string(badMean ? badMean : badCount) +
-        (badMean ? " NaN or infinite values" : " negative or non-finite values") + "; recompute the mesh with Delaunay Image Mesh.");
-    }
-    std::vector<double> values;
-    if (image)
-    {
-      const bool valuesOk = ChosenValues(image, this->GetInputArrayInformation(0), values, error, warning);
-      if (!warning.empty())
-      {
-        vtkWarningMacro("Super-Voxel Cut: " << warning);
-      }
-      if (!valuesOk)
-      {
-        return fail(error);
-      }
-    }
-    this->UpdateProgress(0.2);
+    this->UpdateProgress(0.45);
     const ParallelFor parallel = SMPParallelFor();
-    const SuperVoxelCutResult result = featuremesh::SuperVoxelCut(
-      mesh, mean, count, objectVoxels, backgroundVoxels, image ? values.data() : nullptr, par, parallel,
-      AlgorithmProgress(this, 0.2, 0.95));
+    const SuperVoxelCutResult result = featuremesh::SuperVoxelCut(mesh, data.Owner, data.Mean, data.Count, objectVoxels,
+      backgroundVoxels, image ? data.Values.data() : nullptr, par, AlgorithmProgress(this, 0.45, 0.95));
     if (result.Aborted)
     {
       return 1;
@@ -215,7 +262,7 @@ int vtkSuperVoxelCut::RequestData(
 
     // Output 2: the labels on the image grid.
     SetImageFrame(labelImage, geometry);
-    const std::vector<std::uint8_t> voxelLabels = VoxelLabels(result.VoxelOwner, cut.Label, parallel);
+    const std::vector<std::uint8_t> voxelLabels = VoxelLabels(data.Owner, cut.Label, parallel);
     vtkNew<vtkUnsignedCharArray> voxels;
     voxels->SetName(names::Label);
     voxels->SetNumberOfTuples(geometry.Size());
@@ -226,7 +273,7 @@ int vtkSuperVoxelCut::RequestData(
       vtkNew<vtkIdTypeArray> ids;
       ids->SetName(names::ElementId);
       ids->SetNumberOfTuples(geometry.Size());
-      std::copy(result.VoxelOwner.begin(), result.VoxelOwner.end(), ids->GetPointer(0));
+      std::copy(data.Owner.begin(), data.Owner.end(), ids->GetPointer(0));
       labelImage->GetPointData()->AddArray(ids);
     }
 

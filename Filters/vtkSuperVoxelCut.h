@@ -19,6 +19,8 @@
 #include "FeatureMeshFiltersModule.h"
 #include "vtkUnstructuredGridAlgorithm.h"
 
+#include <memory>
+
 class FEATUREMESHFILTERS_EXPORT vtkSuperVoxelCut : public vtkUnstructuredGridAlgorithm
 {
 public:
@@ -66,7 +68,7 @@ public:
 
 protected:
   vtkSuperVoxelCut();
-  ~vtkSuperVoxelCut() override = default;
+  ~vtkSuperVoxelCut() override;
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int FillOutputPortInformation(int port, vtkInformation* info) override;
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
@@ -86,6 +88,11 @@ protected:
   double SeedRadius;
 
 private:
+  // What depends on the mesh and the image alone (the simplex mesh with its adjacency, the voxel
+  // owners, the element statistics and voxel values), kept while they do not change: a seed edit
+  // re-runs only the cut.
+  struct MeshData;
+  std::unique_ptr<MeshData> Prepared;
   // The pipeline state of the last failed run (0: none), so that it is not repeated.
   vtkMTimeType FailedAt = 0;
   double FailedAtTime = 0.0;

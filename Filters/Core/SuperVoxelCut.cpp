@@ -1,7 +1,5 @@
 #include "SuperVoxelCut.h"
 
-#include "ElementRasterizer.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -78,23 +76,20 @@ std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale)
   return contact;
 }
 
-SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<double>& mean,
+SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<std::int64_t>& owner, const std::vector<double>& mean,
   const std::vector<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
   const std::vector<std::int64_t>& backgroundVoxels, const double* voxelValues,
-  const SuperVoxelCutParameters& parameters, const ParallelFor& parallel, const ProgressFunction& progress)
+  const SuperVoxelCutParameters& parameters, const ProgressFunction& progress)
 {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   SuperVoxelCutResult result;
   const std::int64_t m = mesh.NumberOfElements();
-  const ElementRasterizer raster(mesh);
-  result.VoxelOwner = VoxelOwners(raster, parallel, SubProgress(progress, 0.0, 0.3));
-  if (result.VoxelOwner.empty())
+  if (static_cast<std::int64_t>(owner.size()) != mesh.Geometry().Size())
   {
-    result.Aborted = true;
+    result.Error = "the voxel owners do not match the mesh's image.";
     return result;
   }
-  const std::vector<std::int64_t>& owner = result.VoxelOwner;
 
   CutProblem pr;
   pr.Hard.assign(m, 0);
@@ -149,7 +144,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<dou
     }
   }
   result.SetupSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  result.Cut = BoykovJollyCut(pr, parameters, SubProgress(progress, 0.3, 1.0));
+  result.Cut = BoykovJollyCut(pr, parameters, progress);
   result.Aborted = result.Cut.Aborted;
   if (!result.Cut.Error.empty() || result.Aborted)
   {

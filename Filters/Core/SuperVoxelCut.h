@@ -44,8 +44,6 @@ struct VoxelCutParameters : SeededCutParameters
 struct SuperVoxelCutResult
 {
   CutResult Cut;
-  // Owner element of every voxel (-1 where the mesh does not cover it).
-  std::vector<std::int64_t> VoxelOwner;
   // LabelBoundaryFaces of the labels.
   std::vector<std::int64_t> BoundaryFaces;
   double SetupSeconds = 0.0;
@@ -64,14 +62,15 @@ bool SeedConstraints(const std::vector<std::int64_t>& owner, const std::vector<s
 // voxel-face areas; 1 everywhere when `scale` is off.
 std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale);
 
-// The super-voxel cut. `mean` and `voxelCount` per element (stage 2's MeanIntensity and
-// PixelCount); `voxelValues` (optional, one per voxel of the mesh's image) gives the seed
-// histograms the voxels of the seed elements and enables the voxel region term.
-SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<double>& mean,
+// The super-voxel cut. `owner`: the element owning each voxel (VoxelOwners, ElementRasterizer.h; -1
+// none); with the mesh (and its cached adjacency) it depends on the mesh alone, so a caller that cuts
+// the same mesh again (a seed edit) passes both again. `mean` and `voxelCount` per element (stage 2's
+// MeanIntensity and PixelCount); `voxelValues` (optional, one per voxel of the mesh's image) gives
+// the seed histograms the voxels of the seed elements and enables the voxel region term.
+SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<std::int64_t>& owner, const std::vector<double>& mean,
   const std::vector<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
   const std::vector<std::int64_t>& backgroundVoxels, const double* voxelValues,
-  const SuperVoxelCutParameters& parameters, const ParallelFor& parallel,
-  const ProgressFunction& progress = NoProgress());
+  const SuperVoxelCutParameters& parameters, const ProgressFunction& progress = NoProgress());
 
 // The labels of the elements on the voxel grid (0 where no element owns a voxel).
 std::vector<std::uint8_t> VoxelLabels(const std::vector<std::int64_t>& owner, const std::vector<std::uint8_t>& label,

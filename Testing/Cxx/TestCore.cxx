@@ -565,12 +565,12 @@ TEST(SuperVoxelCut, ContactAndHardConstraintsOnFourTriangles)
   const std::vector<double> mean = { 100, 10, 10, 100 }, count = { 9, 9, 9, 9 };
   SuperVoxelCutParameters par;
   const SuperVoxelCutResult r =
-    SuperVoxelCut(mesh, mean, count, { g.Index(2, 0, 0) }, { g.Index(4, 2, 0) }, nullptr, par, SerialFor());
+    SuperVoxelCut(mesh, owner, mean, count, { g.Index(2, 0, 0) }, { g.Index(4, 2, 0) }, nullptr, par);
   ASSERT_TRUE(r.Error.empty()) << r.Error;
   EXPECT_EQ(r.Cut.Label[0], LabelObject);
   EXPECT_EQ(r.Cut.Label[1], LabelBackground);
   EXPECT_EQ(r.Cut.Label[3], LabelObject);
-  const std::vector<std::uint8_t> voxels = VoxelLabels(r.VoxelOwner, r.Cut.Label, SerialFor());
+  const std::vector<std::uint8_t> voxels = VoxelLabels(owner, r.Cut.Label, SerialFor());
   EXPECT_EQ(voxels[g.Index(2, 0, 0)], LabelObject);
   EXPECT_EQ(voxels[g.Index(4, 2, 0)], LabelBackground);
 }
