@@ -164,7 +164,8 @@ bool ImageGeometryFromFieldData(vtkDataObject* object, ImageGeometry& geometry, 
     d->GetNumberOfComponents() != 3 || o->GetNumberOfTuples() < 1 || s->GetNumberOfTuples() < 1 ||
     d->GetNumberOfTuples() < 1)
   {
-    error = "connect the Image input, or give a mesh made by Delaunay Image Mesh (its field data hold the image grid).";
+    error = "the mesh's field data hold no image frame (ImageOrigin, ImageSpacing, ImageDimensions); meshes made by "
+            "Delaunay Image Mesh and the filters after it carry one.";
     return false;
   }
   ImageGeometry g;

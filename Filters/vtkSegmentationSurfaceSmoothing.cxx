@@ -7,7 +7,6 @@
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
-#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkPointData.h"
 #include "vtkInformation.h"
@@ -94,11 +93,6 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
       return fail("the mesh has no Label cell array; connect the Super-Voxel Cut's first output.");
     }
     ImageGeometry geometry;
-    if (!input->GetFieldData()->GetArray(names::ImageOrigin))
-    {
-      return fail("the mesh's field data hold no image frame (ImageOrigin, ImageSpacing, ImageDimensions, "
-                  "ImageDirection); connect the Super-Voxel Cut's first output, which keeps Delaunay Image Mesh's.");
-    }
     if (!ImageGeometryFromFieldData(input, geometry, error))
     {
       return fail(error);

@@ -166,7 +166,7 @@ int vtkSuperVoxelCut::RequestData(
     ImageGeometry geometry;
     if (image ? !ImageGeometryOf(image, geometry, error) : !ImageGeometryFromFieldData(input, geometry, error))
     {
-      return fail(error);
+      return fail(image ? error : error + " Or connect the Image input.");
     }
     if (image && !MeshMatchesImage(input, geometry, error))
     {

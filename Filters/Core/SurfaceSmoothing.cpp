@@ -280,6 +280,21 @@ struct VolumeMover
   }
 };
 
+// The mean position of row `i`'s neighbours (a non-empty row).
+V3 NeighbourMean(const CompressedRows& rows, std::int64_t i, const std::vector<V3>& positions)
+{
+  V3 mean = { { 0, 0, 0 } };
+  const std::int64_t k = rows.Size(i);
+  for (const std::int64_t* j = rows.Begin(i); j != rows.End(i); ++j)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      mean[a] += positions[*j][a] / k;
+    }
+  }
+  return mean;
+}
+
 V3 Masked(const V3& from, const V3& to, std::uint8_t axes)
 {
   V3 r = from;
@@ -397,21 +412,10 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
         for (std::int64_t i = begin; i < end; ++i)
         {
           next[i] = x[i];
-          const CompressedRows& around = *rows[i];
-          const std::int64_t k = around.Size(i);
-          if (!axes[i] || k == 0)
+          if (axes[i] && rows[i]->Size(i) > 0)
           {
-            continue;
+            next[i] = Masked(x[i], Lerp(x[i], NeighbourMean(*rows[i], i, x), factor), axes[i]);
           }
-          V3 mean = { { 0, 0, 0 } };
-          for (const std::int64_t* j = around.Begin(i); j != around.End(i); ++j)
-          {
-            for (int a = 0; a < 3; ++a)
-            {
-              mean[a] += x[*j][a] / k;
-            }
-          }
-          next[i] = Masked(x[i], Lerp(x[i], mean, factor), axes[i]);
         }
       });
       std::swap(x, next);
@@ -608,16 +612,7 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
       {
         if (ring[*w] > 0 && freeAxes[*w])
         {
-          V3 mean = { { 0, 0, 0 } };
-          const std::int64_t k = neighbours.Size(*w);
-          for (const std::int64_t* u = neighbours.Begin(*w); u != neighbours.End(*w); ++u)
-          {
-            for (int a = 0; a < 3; ++a)
-            {
-              mean[a] += frame[*u][a] / k;
-            }
-          }
-          mover.TryMove(*w, Masked(frame[*w], mean, freeAxes[*w]), true);
+          mover.TryMove(*w, Masked(frame[*w], NeighbourMean(neighbours, *w, frame), freeAxes[*w]), true);
         }
       }
       const double before = shortfall(i);
