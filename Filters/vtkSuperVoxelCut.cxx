@@ -35,8 +35,9 @@ struct vtkSuperVoxelCut::MeshData
   std::vector<std::pair<vtkObject*, vtkMTimeType>> Sources;
   featuremesh::ImageGeometry Frame;
   featuremesh::SimplexMesh Mesh;
-  std::vector<double> Mean, Count, Values;
-  std::vector<std::int64_t> Owner;
+  std::vector<double> Mean, Count;
+  featuremesh::SuperVoxelCutData Cut;
+  featuremesh::MaxFlowCache Flow;
 
   MeshData(std::initializer_list<vtkObject*> sources, const featuremesh::ImageGeometry& frame)
     : Frame(frame)
@@ -213,19 +214,20 @@ int vtkSuperVoxelCut::RequestData(
           std::to_string(badMean ? badMean : badCount) +
           (badMean ? " NaN or infinite values" : " negative or non-finite values") + "; recompute the mesh with Delaunay Image Mesh.");
       }
-      if (valuesArray && !ToDouble(valuesArray, prepared->Values, error))
+      std::vector<double> values;
+      if (valuesArray && !ToDouble(valuesArray, values, error))
       {
         return fail(error);
       }
       this->UpdateProgress(0.1);
-      prepared->Owner = VoxelOwners(ElementRasterizer(prepared->Mesh), SMPParallelFor(), AlgorithmProgress(this, 0.1, 0.4));
-      if (prepared->Owner.empty())
+      if (!PrepareSuperVoxelCut(prepared->Mesh, valuesArray ? values.data() : nullptr, prepared->Cut, error,
+            SMPParallelFor(), AlgorithmProgress(this, 0.1, 0.4)))
       {
-        return 1; // aborted
+        return error.empty() ? 1 : fail(error); // aborted, or a bad value
       }
       this->Prepared = std::move(prepared);
     }
-    const MeshData& data = *this->Prepared;
+    MeshData& data = *this->Prepared;
     const SimplexMesh& mesh = data.Mesh;
     std::vector<std::int64_t> objectVoxels, backgroundVoxels;
     if (!ObjectAndBackgroundVoxels(objectSeeds, backgroundSeeds, geometry, objectVoxels, backgroundVoxels, error))
@@ -235,8 +237,13 @@ int vtkSuperVoxelCut::RequestData(
     const vtkIdType nCells = input->GetNumberOfCells();
     this->UpdateProgress(0.45);
     const ParallelFor parallel = SMPParallelFor();
-    const SuperVoxelCutResult result = featuremesh::SuperVoxelCut(mesh, data.Owner, data.Mean, data.Count, objectVoxels,
-      backgroundVoxels, image ? data.Values.data() : nullptr, par, AlgorithmProgress(this, 0.45, 0.95));
+    VoxelValueFunction voxelValue;
+    if (valuesArray)
+    {
+      voxelValue = [valuesArray](std::int64_t v) { return valuesArray->GetComponent(v, 0); };
+    }
+    const SuperVoxelCutResult result = featuremesh::SuperVoxelCut(mesh, data.Cut, data.Mean, data.Count, objectVoxels,
+      backgroundVoxels, voxelValue, par, AlgorithmProgress(this, 0.45, 0.95), &data.Flow);
     if (result.Aborted)
     {
       return 1;
@@ -262,7 +269,7 @@ int vtkSuperVoxelCut::RequestData(
 
     // Output 2: the labels on the image grid.
     SetImageFrame(labelImage, geometry);
-    const std::vector<std::uint8_t> voxelLabels = VoxelLabels(data.Owner, cut.Label, parallel);
+    const std::vector<std::uint8_t> voxelLabels = VoxelLabels(data.Cut.Owner, cut.Label, parallel);
     vtkNew<vtkUnsignedCharArray> voxels;
     voxels->SetName(names::Label);
     voxels->SetNumberOfTuples(geometry.Size());
@@ -273,7 +280,7 @@ int vtkSuperVoxelCut::RequestData(
       vtkNew<vtkIdTypeArray> ids;
       ids->SetName(names::ElementId);
       ids->SetNumberOfTuples(geometry.Size());
-      std::copy(data.Owner.begin(), data.Owner.end(), ids->GetPointer(0));
+      std::copy(data.Cut.Owner.begin(), data.Cut.Owner.end(), ids->GetPointer(0));
       labelImage->GetPointData()->AddArray(ids);
     }
 

@@ -104,6 +104,56 @@ std::vector<double> SmoothedHistogram(
   return density;
 }
 
+bool GroupVoxelValues(const std::int64_t* owner, const double* values, std::int64_t voxels, std::int64_t nodes,
+  NodeVoxelValues& grouped, std::string& error, const ParallelFor& parallel, const ProgressFunction& progress)
+{
+  std::int64_t bad = 0;
+  for (std::int64_t v = 0; v < voxels; ++v)
+  {
+    bad += std::isfinite(values[v]) && std::fabs(values[v]) <= 1e150 ? 0 : 1;
+  }
+  if (bad)
+  {
+    error = std::to_string(bad) + " intensities are NaN, infinite or beyond +-1e150; replace or rescale them (e.g. with a Calculator) first.";
+    return false;
+  }
+  grouped.Low = Percentile(values, voxels, 0.5);
+  grouped.High = Percentile(values, voxels, 99.5);
+  if (!progress(0.2))
+  {
+    return false;
+  }
+  // A counting sort by node keeps each node's voxels in raster order; sorting them is per node.
+  grouped.Offset.assign(nodes + 1, 0);
+  for (std::int64_t v = 0; v < voxels; ++v)
+  {
+    grouped.Offset[owner[v] + 1] += owner[v] >= 0 ? 1 : 0;
+  }
+  for (std::int64_t p = 0; p < nodes; ++p)
+  {
+    grouped.Offset[p + 1] += grouped.Offset[p];
+  }
+  grouped.Value.resize(grouped.Offset[nodes]);
+  std::vector<std::int64_t> cursor(grouped.Offset.begin(), grouped.Offset.end() - 1);
+  if (!progress(0.4))
+  {
+    return false;
+  }
+  for (std::int64_t v = 0; v < voxels; ++v)
+  {
+    if (owner[v] >= 0)
+    {
+      grouped.Value[cursor[owner[v]]++] = values[v];
+    }
+  }
+  return BatchedFor(nodes, 4096, parallel, SubProgress(progress, 0.6, 1.0), [&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t p = b; p < e; ++p)
+    {
+      std::sort(grouped.Value.begin() + grouped.Offset[p], grouped.Value.begin() + grouped.Offset[p + 1]);
+    }
+  });
+}
+
 namespace
 {
 // libmaxflow calls this before exit(1) when an allocation fails: throwing keeps the host alive.
@@ -131,7 +181,9 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
   const std::int64_t m = static_cast<std::int64_t>(pr.A.size());
   if ((!pr.Size.empty() && static_cast<std::int64_t>(pr.Size.size()) != n) ||
     static_cast<std::int64_t>(pr.Hard.size()) != n || static_cast<std::int64_t>(pr.B.size()) != m ||
-    (!pr.Contact.empty() && static_cast<std::int64_t>(pr.Contact.size()) != m))
+    (!pr.Contact.empty() && static_cast<std::int64_t>(pr.Contact.size()) != m) ||
+    (pr.NodeVoxels && (static_cast<std::int64_t>(pr.NodeVoxels->Offset.size()) != n + 1 ||
+                        pr.NodeVoxels->Offset.back() != static_cast<std::int64_t>(pr.NodeVoxels->Value.size()))))
   {
     return "the graph's arrays disagree in length.";
   }
@@ -163,18 +215,6 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
       badValue += Usable(v) ? 0 : 1;
     }
   }
-  if (pr.VoxelValue && pr.VoxelOwner)
-  {
-    for (std::int64_t v = 0; v < pr.VoxelTotal; ++v)
-    {
-      badValue += Usable(pr.VoxelValue[v]) ? 0 : 1;
-      if ((v & CheckEvery) == CheckEvery && !progress(static_cast<double>(v) / static_cast<double>(pr.VoxelTotal)))
-      {
-        aborted = true;
-        return std::string();
-      }
-    }
-  }
   if (badValue)
   {
     return std::to_string(badValue) + " intensities are NaN, infinite or beyond +-1e150; replace or rescale them (e.g. with a Calculator) first.";
@@ -191,7 +231,18 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
 }
 } // namespace
 
-CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par, const ProgressFunction& progress)
+using Flow = maxflow::Graph_DDD;
+
+// The graph after its last max-flow, and what it was built from.
+struct MaxFlowCache::Kept
+{
+  std::shared_ptr<Flow> Graph;
+  std::vector<std::int64_t> A, B;
+  std::vector<double> Weight, Source, Sink;
+};
+
+CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par, const ProgressFunction& progress,
+  MaxFlowCache* cache)
 {
   CutResult r;
   const auto t0 = Clock::now();
@@ -231,10 +282,9 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     return r;
   }
   r.Bins = par.Bins > 0 ? par.Bins : 64;
-  const bool exact = pr.VoxelValue && pr.VoxelOwner;
-  const double* rangeData = exact ? pr.VoxelValue : pr.Value.data();
-  const std::int64_t rangeCount = exact ? pr.VoxelTotal : n;
-  double low = Percentile(rangeData, rangeCount, 0.5), high = Percentile(rangeData, rangeCount, 99.5);
+  const NodeVoxelValues* exact = pr.NodeVoxels;
+  double low = exact ? exact->Low : Percentile(pr.Value.data(), n, 0.5);
+  double high = exact ? exact->High : Percentile(pr.Value.data(), n, 99.5);
   for (double v : pr.ObjectSamples)
   {
     low = std::min(low, v);
@@ -307,18 +357,23 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   std::unique_ptr<double[]> regionObject(new double[n]), regionBackground(new double[n]);
   if (exact)
   {
-    std::fill(regionObject.get(), regionObject.get() + n, 0.0);
-    std::fill(regionBackground.get(), regionBackground.get() + n, 0.0);
-    for (std::int64_t v = 0; v < pr.VoxelTotal; ++v)
+    // Each node's values are sorted and bin() is monotone: one binary search per bin a node spans.
+    const double* all = exact->Value.data();
+    for (std::int64_t p = 0; p < n; ++p)
     {
-      const std::int64_t p = pr.VoxelOwner[v];
-      if (p >= 0 && p < n)
+      double sumObject = 0.0, sumBackground = 0.0;
+      for (const double *x = all + exact->Offset[p], *end = all + exact->Offset[p + 1]; x < end;)
       {
-        const int b = bin(pr.VoxelValue[v]);
-        regionObject[p] += costObject[b];
-        regionBackground[p] += costBackground[b];
+        const int b = bin(*x);
+        const double* next = b == r.Bins - 1 ? end : std::partition_point(x, end, [&](double y) { return bin(y) <= b; });
+        const double count = static_cast<double>(next - x);
+        sumObject += count * costObject[b];
+        sumBackground += count * costBackground[b];
+        x = next;
       }
-      if (aborted(v, pr.VoxelTotal, 0.2, 0.35))
+      regionObject[p] = sumObject;
+      regionBackground[p] = sumBackground;
+      if (aborted(p, n, 0.2, 0.3))
       {
         return r;
       }
@@ -359,48 +414,69 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     r.Error = "the energy overflows (lambda, the contact areas or the graph are too large); lower lambda.";
     return r;
   }
-  using G = maxflow::Graph_DDD;
-  std::shared_ptr<G> g;
+  // Terminal capacities (source = object: a node left on the source side pays its sink capacity).
+  auto source = [&](std::int64_t p) { return pr.Hard[p] == 1 ? K : (pr.Hard[p] == 2 ? 0.0 : regionBackground[p]); };
+  auto sink = [&](std::int64_t p) { return pr.Hard[p] == 2 ? K : (pr.Hard[p] == 1 ? 0.0 : regionObject[p]); };
+  // The kept flow applies when only terminal capacities changed: same edges, same weights.
+  std::shared_ptr<MaxFlowCache::Kept> kept = cache ? cache->State : nullptr;
+  if (cache)
+  {
+    cache->Clear(); // until this cut's flow has finished
+  }
+  const bool reuse = kept && kept->A == pr.A && kept->B == pr.B && kept->Source.size() == static_cast<size_t>(n) &&
+    std::equal(kept->Weight.begin(), kept->Weight.end(), weight.get(), weight.get() + m);
+  std::shared_ptr<Flow> g;
   try
   {
-    g = std::make_shared<G>(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory);
-    // Nodes in chunks (the same ids as one call): first touching a 9 M-voxel graph's memory takes
-    // seconds, and progress must keep coming.
-    constexpr std::int64_t chunk = std::int64_t(1) << 20;
-    for (std::int64_t p = 0; p < n; p += chunk)
+    if (reuse)
     {
-      g->add_node(static_cast<int>(std::min(chunk, n - p)));
-      if (phaseAborted(0.35 + 0.05 * static_cast<double>(p) / static_cast<double>(n)))
+      // Kohli-Torr: the residual graph takes the capacity changes as signed terminal residuals; only
+      // nodes whose residual changes sign (or zero status) need their search trees redone.
+      g = kept->Graph;
+      for (std::int64_t p = 0; p < n; ++p)
       {
-        return r;
+        const double ds = source(p) - kept->Source[p], dt = sink(p) - kept->Sink[p];
+        if (ds != 0.0 || dt != 0.0)
+        {
+          const double before = g->get_trcap(static_cast<int>(p));
+          g->add_tweights(static_cast<int>(p), ds, dt);
+          const double after = g->get_trcap(static_cast<int>(p));
+          if ((before > 0) != (after > 0) || (before < 0) != (after < 0))
+          {
+            g->mark_node(static_cast<int>(p));
+          }
+        }
       }
     }
-    for (std::int64_t p = 0; p < n; ++p)
+    else
     {
-      if (aborted(p, n, 0.4, 0.45))
+      g = std::make_shared<Flow>(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory);
+      // Nodes in chunks (the same ids as one call): first touching a 9 M-voxel graph's memory takes
+      // seconds, and progress must keep coming.
+      constexpr std::int64_t chunk = std::int64_t(1) << 20;
+      for (std::int64_t p = 0; p < n; p += chunk)
       {
-        return r;
+        g->add_node(static_cast<int>(std::min(chunk, n - p)));
+        if (phaseAborted(0.35 + 0.05 * static_cast<double>(p) / static_cast<double>(n)))
+        {
+          return r;
+        }
       }
-      if (pr.Hard[p] == 1)
+      for (std::int64_t p = 0; p < n; ++p)
       {
-        g->add_tweights(static_cast<int>(p), K, 0.0);
+        if (aborted(p, n, 0.4, 0.45))
+        {
+          return r;
+        }
+        g->add_tweights(static_cast<int>(p), source(p), sink(p));
       }
-      else if (pr.Hard[p] == 2)
+      for (std::int64_t e = 0; e < m; ++e)
       {
-        g->add_tweights(static_cast<int>(p), 0.0, K);
-      }
-      else
-      {
-        // Source = object: a node left on the source side pays its sink capacity.
-        g->add_tweights(static_cast<int>(p), regionBackground[p], regionObject[p]);
-      }
-    }
-    for (std::int64_t e = 0; e < m; ++e)
-    {
-      g->add_edge(static_cast<int>(pr.A[e]), static_cast<int>(pr.B[e]), weight[e], weight[e]);
-      if (aborted(e, m, 0.45, 0.5))
-      {
-        return r;
+        g->add_edge(static_cast<int>(pr.A[e]), static_cast<int>(pr.B[e]), weight[e], weight[e]);
+        if (aborted(e, m, 0.45, 0.5))
+        {
+          return r;
+        }
       }
     }
   }
@@ -412,18 +488,18 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   const auto t1 = Clock::now();
   r.GraphSeconds = std::chrono::duration<double>(t1 - t0).count();
   // The max-flow has no progress or abort of its own: it runs on its own thread, owning the graph.
-  using Flow = std::pair<double, std::vector<std::uint8_t>>;
-  Flow flow;
+  using FlowResult = std::pair<double, std::vector<std::uint8_t>>;
+  FlowResult flow;
   try
   {
-    const bool done = RunWithHeartbeat<Flow>(
-      [g, n]() {
-        Flow f;
-        f.first = g->maxflow();
+    const bool done = RunWithHeartbeat<FlowResult>(
+      [g, n, reuse]() {
+        FlowResult f;
+        f.first = g->maxflow(reuse);
         f.second.resize(n);
         for (std::int64_t p = 0; p < n; ++p)
         {
-          f.second[p] = g->what_segment(static_cast<int>(p)) == G::SOURCE ? 1 : 0;
+          f.second[p] = g->what_segment(static_cast<int>(p)) == Flow::SOURCE ? 1 : 0;
         }
         return f;
       },
@@ -441,6 +517,25 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   }
   r.Flow = flow.first;
   r.Label = std::move(flow.second);
+  if (cache)
+  {
+    if (!reuse)
+    {
+      kept = std::make_shared<MaxFlowCache::Kept>();
+      kept->A = pr.A;
+      kept->B = pr.B;
+      kept->Weight.assign(weight.get(), weight.get() + m);
+    }
+    kept->Graph = g;
+    kept->Source.resize(n);
+    kept->Sink.resize(n);
+    for (std::int64_t p = 0; p < n; ++p)
+    {
+      kept->Source[p] = source(p);
+      kept->Sink[p] = sink(p);
+    }
+    cache->State = kept;
+  }
   r.FlowSeconds = std::chrono::duration<double>(Clock::now() - t1).count();
   // Hard constraints hold by construction; a non-finite energy would break them silently.
   for (std::int64_t p = 0; p < n; ++p)

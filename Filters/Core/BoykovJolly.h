@@ -7,14 +7,15 @@
 // Pr(I | object/background) is a kernel density estimate of the seed samples on a histogram over a
 // robust intensity range (0.5 to 99.5 percentiles of the node intensities, or of the voxel values
 // with the voxel region term), mixed with 1 % of a uniform density so that no intensity is impossible.
-// With the voxel region term (VoxelValue/VoxelOwner set) a super-voxel's region cost is the sum of
-// its voxels' costs, so for region terms the super-voxel cut is the voxel cut restricted to labellings
-// that are constant on elements.
+// With the voxel region term (NodeVoxels set) a super-voxel's region cost is the sum of its voxels'
+// costs, so for region terms the super-voxel cut is the voxel cut restricted to labellings that are
+// constant on elements.
 #pragma once
 
 #include "Parallel.h"
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,21 @@ struct BoykovJollyParameters
   double Bandwidth = 1.0;
 };
 
+// The voxel values of every node, grouped once per graph so that a cut pays per node, not per voxel:
+// node p's values in ascending order are Value[Offset[p] .. Offset[p + 1]); the histogram range
+// comes from Low and High, the 0.5 and 99.5 percentiles of all voxel values.
+struct NodeVoxelValues
+{
+  std::vector<std::int64_t> Offset;
+  std::vector<double> Value;
+  double Low = 0.0, High = 0.0;
+};
+
+// Groups `voxels` values by their node (owner[v], -1 = none, in [-1, nodes)). False with a sentence
+// when a value is not finite or beyond +-1e150; false without one when progress asked to abort.
+bool GroupVoxelValues(const std::int64_t* owner, const double* values, std::int64_t voxels, std::int64_t nodes,
+  NodeVoxelValues& grouped, std::string& error, const ParallelFor& parallel, const ProgressFunction& progress = NoProgress());
+
 struct CutProblem
 {
   std::vector<double> Value;   // intensity of each node (mean intensity for an element)
@@ -42,13 +58,10 @@ struct CutProblem
   std::vector<double> Contact; // per edge, in voxel faces; empty = 1 each (the voxel grid)
   std::vector<std::uint8_t> Hard; // 0 free, 1 object seed, 2 background seed
   std::vector<double> ObjectSamples, ObjectWeights, BackgroundSamples, BackgroundWeights;
-  // Optional exact region term for super-voxels (not owned; both set or both null): node p's region
-  // cost becomes the sum over its voxels v (VoxelOwner[v] == p, -1 = none) of -ln Pr(VoxelValue[v] | L)
-  // instead of Size_p * -ln Pr(Value_p | L). A mixed element then costs what its voxels would cost
-  // in the voxel cut, rather than what its mean would.
-  const double* VoxelValue = nullptr;
-  const std::int64_t* VoxelOwner = nullptr;
-  std::int64_t VoxelTotal = 0;
+  // Optional exact region term for super-voxels (not owned): node p's region cost becomes the sum
+  // over its voxel values x of -ln Pr(x | L) instead of Size_p * -ln Pr(Value_p | L). A mixed
+  // element then costs what its voxels would cost in the voxel cut, rather than what its mean would.
+  const NodeVoxelValues* NodeVoxels = nullptr;
 };
 
 struct CutResult
@@ -73,10 +86,26 @@ std::string ValidateParameters(const BoykovJollyParameters& p);
 std::vector<double> SmoothedHistogram(const std::vector<double>& samples, const std::vector<double>& weights,
   double low, double high, int bins, double bandwidth = 1.0);
 
+// A max-flow kept between cuts of one graph (Kohli and Torr's dynamic graph cuts): when the next cut
+// differs only in terminal capacities (a seed edit), it starts from this flow and its search trees
+// instead of from zero. Any other change starts afresh. Not for sharing between threads.
+class MaxFlowCache
+{
+public:
+  void Clear() { this->State.reset(); }
+  bool Empty() const { return !this->State; }
+  struct Kept;
+
+private:
+  friend CutResult BoykovJollyCut(const CutProblem&, const BoykovJollyParameters&, const ProgressFunction&, MaxFlowCache*);
+  std::shared_ptr<Kept> State;
+};
+
 // Every input is checked first (finite values within +-1e150, non-negative sizes and contacts,
 // edges naming nodes): a problem is an Error sentence, never a NaN in a capacity. Running out of
 // memory is an Error, not an exit. Progress is reported on the caller's thread; when it asks to
 // abort, the result is Aborted (the max-flow is then left to finish on its own thread).
+// With `cache`, the flow is kept for the next cut and taken from the last one when it applies.
 CutResult BoykovJollyCut(const CutProblem& problem, const BoykovJollyParameters& parameters,
-  const ProgressFunction& progress = NoProgress());
+  const ProgressFunction& progress = NoProgress(), MaxFlowCache* cache = nullptr);
 } // namespace featuremesh

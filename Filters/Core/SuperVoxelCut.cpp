@@ -1,4 +1,5 @@
 #include "SuperVoxelCut.h"
+#include "ElementRasterizer.h"
 
 #include <algorithm>
 #include <chrono>
@@ -37,7 +38,7 @@ bool SeedConstraints(const std::vector<std::int64_t>& owner, const std::vector<s
   return true;
 }
 
-void SeedNeighbourhoodSamples(const double* values, const ImageGeometry& g,
+void SeedNeighbourhoodSamples(const VoxelValueFunction& value, const ImageGeometry& g,
   const std::vector<std::int64_t>& seedVoxels, double radius, std::vector<double>& samples)
 {
   const int r = static_cast<int>(std::floor(radius));
@@ -53,7 +54,7 @@ void SeedNeighbourhoodSamples(const double* values, const ImageGeometry& g,
         {
           if (di * di + dj * dj + dk * dk <= radius * radius && g.Contains(i + di, j + dj, k + dk))
           {
-            samples.push_back(values[g.Index(i + di, j + dj, k + dk)]);
+            samples.push_back(value(g.Index(i + di, j + dj, k + dk)));
           }
         }
   }
@@ -76,16 +77,31 @@ std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale)
   return contact;
 }
 
-SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<std::int64_t>& owner, const std::vector<double>& mean,
+bool PrepareSuperVoxelCut(const SimplexMesh& mesh, const double* voxelValues, SuperVoxelCutData& data,
+  std::string& error, const ParallelFor& parallel, const ProgressFunction& progress)
+{
+  data.Owner = VoxelOwners(ElementRasterizer(mesh), parallel, SubProgress(progress, 0.0, voxelValues ? 0.6 : 1.0));
+  if (data.Owner.empty())
+  {
+    return false;
+  }
+  return !voxelValues ||
+    GroupVoxelValues(data.Owner.data(), voxelValues, mesh.Geometry().Size(), mesh.NumberOfElements(), data.Voxels,
+      error, parallel, SubProgress(progress, 0.6, 1.0));
+}
+
+SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutData& data, const std::vector<double>& mean,
   const std::vector<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
-  const std::vector<std::int64_t>& backgroundVoxels, const double* voxelValues,
-  const SuperVoxelCutParameters& parameters, const ProgressFunction& progress)
+  const std::vector<std::int64_t>& backgroundVoxels, const VoxelValueFunction& voxelValue,
+  const SuperVoxelCutParameters& parameters, const ProgressFunction& progress, MaxFlowCache* flow)
 {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   SuperVoxelCutResult result;
   const std::int64_t m = mesh.NumberOfElements();
-  if (static_cast<std::int64_t>(owner.size()) != mesh.Geometry().Size())
+  const std::vector<std::int64_t>& owner = data.Owner;
+  if (static_cast<std::int64_t>(owner.size()) != mesh.Geometry().Size() ||
+    (data.HasVoxelValues() && static_cast<std::int64_t>(data.Voxels.Offset.size()) != m + 1))
   {
     result.Error = "the voxel owners do not match the mesh's image.";
     return result;
@@ -105,31 +121,28 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<std
   pr.Contact = ContactInVoxelFaces(mesh, parameters.ScaleByContact);
   // Seed histograms: the voxels of the seed elements when the values are there, else their means
   // weighted by their voxel counts.
-  if (voxelValues)
+  if (data.HasVoxelValues())
   {
-    const std::int64_t n = mesh.Geometry().Size();
-    if (parameters.SampleSeedElements)
+    const NodeVoxelValues& grouped = data.Voxels;
+    if (parameters.SampleSeedElements || !voxelValue)
     {
-      for (std::int64_t v = 0; v < n; ++v)
+      for (std::int64_t e = 0; e < m; ++e)
       {
-        const std::int64_t e = owner[v];
-        if (e >= 0 && pr.Hard[e])
+        if (pr.Hard[e])
         {
-          (pr.Hard[e] == 1 ? pr.ObjectSamples : pr.BackgroundSamples).push_back(voxelValues[v]);
+          std::vector<double>& samples = pr.Hard[e] == 1 ? pr.ObjectSamples : pr.BackgroundSamples;
+          samples.insert(samples.end(), grouped.Value.begin() + grouped.Offset[e], grouped.Value.begin() + grouped.Offset[e + 1]);
         }
       }
     }
     else
     {
-      SeedNeighbourhoodSamples(voxelValues, mesh.Geometry(), objectVoxels, parameters.SeedRadius, pr.ObjectSamples);
-      SeedNeighbourhoodSamples(
-        voxelValues, mesh.Geometry(), backgroundVoxels, parameters.SeedRadius, pr.BackgroundSamples);
+      SeedNeighbourhoodSamples(voxelValue, mesh.Geometry(), objectVoxels, parameters.SeedRadius, pr.ObjectSamples);
+      SeedNeighbourhoodSamples(voxelValue, mesh.Geometry(), backgroundVoxels, parameters.SeedRadius, pr.BackgroundSamples);
     }
     if (parameters.VoxelRegionTerm)
     {
-      pr.VoxelValue = voxelValues;
-      pr.VoxelOwner = owner.data();
-      pr.VoxelTotal = n;
+      pr.NodeVoxels = &grouped;
     }
   }
   else
@@ -144,7 +157,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<std
     }
   }
   result.SetupSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  result.Cut = BoykovJollyCut(pr, parameters, progress);
+  result.Cut = BoykovJollyCut(pr, parameters, progress, flow);
   result.Aborted = result.Cut.Aborted;
   if (!result.Cut.Error.empty() || result.Aborted)
   {
@@ -208,8 +221,9 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
     }
     pr.Hard[v] = 2;
   }
-  SeedNeighbourhoodSamples(pr.Value.data(), g, objectVoxels, parameters.SeedRadius, pr.ObjectSamples);
-  SeedNeighbourhoodSamples(pr.Value.data(), g, backgroundVoxels, parameters.SeedRadius, pr.BackgroundSamples);
+  const VoxelValueFunction value = [&pr](std::int64_t v) { return pr.Value[v]; };
+  SeedNeighbourhoodSamples(value, g, objectVoxels, parameters.SeedRadius, pr.ObjectSamples);
+  SeedNeighbourhoodSamples(value, g, backgroundVoxels, parameters.SeedRadius, pr.BackgroundSamples);
   const std::int64_t sx = 1, sy = g.Dims[0], sz = g.SliceStride();
   const std::int64_t edges = (g.Dims[0] - 1) * std::int64_t(g.Dims[1]) * g.Dims[2] +
     std::int64_t(g.Dims[0]) * (g.Dims[1] - 1) * g.Dims[2] + (g.Is2D() ? 0 : sz * (g.Dims[2] - 1));

@@ -9,6 +9,7 @@
 #include "SimplexMesh.h"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -62,15 +63,34 @@ bool SeedConstraints(const std::vector<std::int64_t>& owner, const std::vector<s
 // voxel-face areas; 1 everywhere when `scale` is off.
 std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale);
 
-// The super-voxel cut. `owner`: the element owning each voxel (VoxelOwners, ElementRasterizer.h; -1
-// none); with the mesh (and its cached adjacency) it depends on the mesh alone, so a caller that cuts
-// the same mesh again (a seed edit) passes both again. `mean` and `voxelCount` per element (stage 2's
-// MeanIntensity and PixelCount); `voxelValues` (optional, one per voxel of the mesh's image) gives
-// the seed histograms the voxels of the seed elements and enables the voxel region term.
-SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const std::vector<std::int64_t>& owner, const std::vector<double>& mean,
+// What the super-voxel cut keeps of a mesh and its image across cuts: it depends on them alone, so
+// a seed edit or a parameter change reuses it.
+struct SuperVoxelCutData
+{
+  // The element owning each voxel (VoxelOwners, ElementRasterizer.h; -1 none).
+  std::vector<std::int64_t> Owner;
+  // Each element's voxel values; empty without voxel values.
+  NodeVoxelValues Voxels;
+  bool HasVoxelValues() const { return !this->Voxels.Offset.empty(); }
+};
+
+// Rasterises the mesh and groups `voxelValues` (optional, one per voxel of the mesh's image) by
+// element. False with a sentence for a bad value, without one when progress asked to abort.
+bool PrepareSuperVoxelCut(const SimplexMesh& mesh, const double* voxelValues, SuperVoxelCutData& data,
+  std::string& error, const ParallelFor& parallel, const ProgressFunction& progress = NoProgress());
+
+// A voxel's value by index (the image, however it is stored).
+using VoxelValueFunction = std::function<double(std::int64_t)>;
+
+// The super-voxel cut of a prepared mesh. `mean` and `voxelCount` per element (stage 2's
+// MeanIntensity and PixelCount). With voxel values prepared, the seed histograms take the voxels of
+// the seed elements (or, without SampleSeedElements, those near each seed voxel, read through
+// `voxelValue`) and the voxel region term is available. `flow` (optional) keeps the max-flow for
+// the next cut of the same mesh.
+SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutData& data, const std::vector<double>& mean,
   const std::vector<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
-  const std::vector<std::int64_t>& backgroundVoxels, const double* voxelValues,
-  const SuperVoxelCutParameters& parameters, const ProgressFunction& progress = NoProgress());
+  const std::vector<std::int64_t>& backgroundVoxels, const VoxelValueFunction& voxelValue,
+  const SuperVoxelCutParameters& parameters, const ProgressFunction& progress = NoProgress(), MaxFlowCache* flow = nullptr);
 
 // The labels of the elements on the voxel grid (0 where no element owns a voxel).
 std::vector<std::uint8_t> VoxelLabels(const std::vector<std::int64_t>& owner, const std::vector<std::uint8_t>& label,
@@ -86,6 +106,6 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& geometry,
 std::string ValidateParameters(const SeededCutParameters& p);
 
 // Appends to `samples` the values of the voxels within `radius` (voxels) of each seed voxel.
-void SeedNeighbourhoodSamples(const double* values, const ImageGeometry& geometry,
+void SeedNeighbourhoodSamples(const VoxelValueFunction& value, const ImageGeometry& geometry,
   const std::vector<std::int64_t>& seedVoxels, double radius, std::vector<double>& samples);
 } // namespace featuremesh

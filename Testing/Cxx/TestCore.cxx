@@ -420,9 +420,10 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   pr.ObjectSamples = { 10.0, 11.0, 12.4 };
   pr.BackgroundSamples = { 0.0, 1.2, 2.4 };
   const CutResult byMean = BoykovJollyCut(pr, BoykovJollyParameters());
-  pr.VoxelValue = pixels.data();
-  pr.VoxelOwner = owner.data();
-  pr.VoxelTotal = static_cast<std::int64_t>(pixels.size());
+  NodeVoxelValues grouped;
+  std::string error;
+  ASSERT_TRUE(GroupVoxelValues(owner.data(), pixels.data(), 30, 30, grouped, error, SerialFor()));
+  pr.NodeVoxels = &grouped;
   const CutResult byVoxel = BoykovJollyCut(pr, BoykovJollyParameters());
   ASSERT_TRUE(byMean.Error.empty() && byVoxel.Error.empty());
   EXPECT_EQ(byMean.Label, byVoxel.Label);
@@ -441,9 +442,15 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   const std::vector<std::int64_t> o = { 0, 1, 2, 2, 2, 2 };
   two.ObjectSamples = { 10.0, 9.0, 11.0 };
   two.BackgroundSamples = { 0.0, 1.0, -1.0 };
-  two.VoxelValue = v.data();
-  two.VoxelOwner = o.data();
-  two.VoxelTotal = 6;
+  NodeVoxelValues twoGrouped;
+  ASSERT_TRUE(GroupVoxelValues(o.data(), v.data(), 6, 3, twoGrouped, error, SerialFor()));
+  EXPECT_EQ(twoGrouped.Offset, (std::vector<std::int64_t>{ 0, 1, 2, 6 }));
+  EXPECT_EQ(twoGrouped.Value, (std::vector<double>{ 10.0, 0.0, 0.0, 10.0, 10.0, 10.0 }));
+  two.NodeVoxels = &twoGrouped;
+  const std::vector<double> nan = { 1.0, std::nan(""), 2.0, 3.0, 4.0, 5.0 };
+  NodeVoxelValues badGrouped;
+  EXPECT_FALSE(GroupVoxelValues(o.data(), nan.data(), 6, 3, badGrouped, error, SerialFor()));
+  EXPECT_EQ(error.rfind("1 intensities are NaN", 0), 0u) << error;
   const CutResult exact = BoykovJollyCut(two, BoykovJollyParameters());
   ASSERT_TRUE(exact.Error.empty());
   EXPECT_EQ(exact.Label[2], 1);
@@ -548,8 +555,10 @@ TEST(SuperVoxelCut, ContactAndHardConstraintsOnFourTriangles)
   for (double c : ContactInVoxelFaces(mesh, false))
     EXPECT_EQ(c, 1.0);
 
-  const ElementRasterizer raster(mesh);
-  const std::vector<std::int64_t> owner = VoxelOwners(raster, SerialFor());
+  SuperVoxelCutData data;
+  std::string prepareError;
+  ASSERT_TRUE(PrepareSuperVoxelCut(mesh, nullptr, data, prepareError, SerialFor()));
+  const std::vector<std::int64_t>& owner = data.Owner;
   const ImageGeometry& g = mesh.Geometry();
   std::vector<std::uint8_t> hard(4, 0);
   std::string error;
@@ -565,7 +574,7 @@ TEST(SuperVoxelCut, ContactAndHardConstraintsOnFourTriangles)
   const std::vector<double> mean = { 100, 10, 10, 100 }, count = { 9, 9, 9, 9 };
   SuperVoxelCutParameters par;
   const SuperVoxelCutResult r =
-    SuperVoxelCut(mesh, owner, mean, count, { g.Index(2, 0, 0) }, { g.Index(4, 2, 0) }, nullptr, par);
+    SuperVoxelCut(mesh, data, mean, count, { g.Index(2, 0, 0) }, { g.Index(4, 2, 0) }, VoxelValueFunction(), par);
   ASSERT_TRUE(r.Error.empty()) << r.Error;
   EXPECT_EQ(r.Cut.Label[0], LabelObject);
   EXPECT_EQ(r.Cut.Label[1], LabelBackground);
