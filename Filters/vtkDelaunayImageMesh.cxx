@@ -217,8 +217,9 @@ int vtkDelaunayImageMesh::RequestData(
     t0 = Clock::now();
     const ParallelFor parallel = SMPParallelFor();
     const SimplexMesh mesh(geometry, std::move(index), std::move(delaunay.Cells), delaunay.VerticesPerCell);
-    const ElementStatistics stats =
-      ComputeElementStatistics(ElementRasterizer(mesh), values.data(), parallel, AlgorithmProgress(this, 0.5, 0.9));
+    const vtkSmartPointer<vtkIntArray> owner = NewVoxelOwnerArray(geometry.Size());
+    const ElementStatistics stats = ComputeElementStatistics(
+      ElementRasterizer(mesh), values.data(), parallel, AlgorithmProgress(this, 0.5, 0.9), owner->GetPointer(0));
     if (stats.Aborted)
     {
       return 1;
@@ -228,6 +229,7 @@ int vtkDelaunayImageMesh::RequestData(
     const double statisticsSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
     this->UpdateProgress(0.9);
     WriteImageMesh(mesh, stats, minAngle, radiusRatio, output);
+    AttachVoxelOwners(output, owner);
 
     // Node arrays pass through; added nodes get NodeType Added and Fixed 1 (corners) or 0 (refinement).
     const vtkIdType nPts = mesh.NumberOfPoints();

@@ -26,11 +26,13 @@
 #include "vtkStripper.h"
 #include "vtkSMPTools.h"
 #include "vtkType.h"
+#include "vtkTypeUInt64Array.h"
 
 #include <algorithm>
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 
 namespace featuremesh
@@ -524,6 +526,79 @@ const float* FloatValues(vtkDataArray* array, std::vector<float>& storage, std::
   }
   // Conversion, or the NaN/Inf error message.
   return ToFloat(array, storage, error) ? storage.data() : nullptr;
+}
+
+vtkSmartPointer<vtkIntArray> NewVoxelOwnerArray(std::int64_t voxels)
+{
+  auto owner = vtkSmartPointer<vtkIntArray>::New();
+  owner->SetName(names::VoxelOwner);
+  owner->SetNumberOfTuples(static_cast<vtkIdType>(voxels));
+  return owner;
+}
+
+std::uint64_t MeshDigest(vtkUnstructuredGrid* grid)
+{
+  // FNV-1a over 64-bit words (and the tail bytes) of each array, with its type and length.
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  auto mix = [&h](std::uint64_t w) { h = (h ^ w) * 0x100000001b3ULL; };
+  auto add = [&](vtkDataArray* a) {
+    if (!a)
+    {
+      mix(0);
+      return;
+    }
+    const size_t bytes = static_cast<size_t>(a->GetDataSize()) * static_cast<size_t>(a->GetDataTypeSize());
+    mix(static_cast<std::uint64_t>(a->GetDataType()));
+    mix(bytes);
+    const unsigned char* p = static_cast<const unsigned char*>(a->GetVoidPointer(0));
+    size_t i = 0;
+    for (; i + 8 <= bytes; i += 8)
+    {
+      std::uint64_t w;
+      std::memcpy(&w, p + i, 8);
+      mix(w);
+    }
+    for (; i < bytes; ++i)
+    {
+      mix(p[i]);
+    }
+  };
+  add(grid->GetPoints() ? grid->GetPoints()->GetData() : nullptr);
+  vtkCellArray* cells = grid->GetCells();
+  add(cells ? cells->GetConnectivityArray() : nullptr);
+  add(cells ? cells->GetOffsetsArray() : nullptr);
+  return h;
+}
+
+void AttachVoxelOwners(vtkUnstructuredGrid* mesh, vtkIntArray* owner)
+{
+  mesh->GetFieldData()->AddArray(owner);
+  vtkNew<vtkTypeUInt64Array> digest;
+  digest->SetName(names::VoxelOwnerDigest);
+  digest->InsertNextValue(MeshDigest(mesh));
+  mesh->GetFieldData()->AddArray(digest);
+}
+
+void DropVoxelOwners(vtkDataObject* object)
+{
+  object->GetFieldData()->RemoveArray(names::VoxelOwner);
+  object->GetFieldData()->RemoveArray(names::VoxelOwnerDigest);
+}
+
+bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, std::vector<std::int32_t>& owner)
+{
+  vtkIntArray* array = vtkIntArray::SafeDownCast(mesh->GetFieldData()->GetAbstractArray(names::VoxelOwner));
+  vtkTypeUInt64Array* digest = vtkTypeUInt64Array::SafeDownCast(mesh->GetFieldData()->GetAbstractArray(names::VoxelOwnerDigest));
+  if (!array || !digest || array->GetNumberOfComponents() != 1 || array->GetNumberOfTuples() != voxels ||
+    digest->GetNumberOfTuples() != 1 || digest->GetValue(0) != MeshDigest(mesh))
+  {
+    return false;
+  }
+  const std::int32_t* p = array->GetPointer(0);
+  const vtkIdType cells = mesh->GetNumberOfCells();
+  owner.assign(p, p + voxels);
+  // Ids must name cells: a map edited by hand is not trusted.
+  return std::all_of(owner.begin(), owner.end(), [cells](std::int32_t e) { return e >= -1 && e < cells; });
 }
 
 bool ToDouble(vtkDataArray* array, std::vector<double>& values, std::string& error)

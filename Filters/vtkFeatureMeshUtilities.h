@@ -9,8 +9,11 @@
 #include "Parallel.h"
 #include "SimplexMesh.h"
 
+#include "vtkIntArray.h"
 #include "vtkSMPTools.h"
+#include "vtkSmartPointer.h"
 
+#include <cstdint>
 #include <cstdlib>
 #include <exception>
 #include <string>
@@ -130,6 +133,18 @@ bool ToSimplexMesh(vtkUnstructuredGrid* grid, const ImageGeometry& geometry, Sim
 // coordinates), the statistics and quality cell arrays, the image frame and summary field data.
 void WriteImageMesh(const SimplexMesh& mesh, const ElementStatistics& statistics, const std::vector<double>& minAngle,
   const std::vector<double>& radiusRatio, vtkUnstructuredGrid* output);
+
+// The owner map of stages 2 and 3 (Contract.h, VoxelOwner): a fresh array of `voxels` tuples to fill
+// (ComputeElementStatistics), attached to the written mesh with the digest of its points and cells.
+vtkSmartPointer<vtkIntArray> NewVoxelOwnerArray(std::int64_t voxels);
+void AttachVoxelOwners(vtkUnstructuredGrid* mesh, vtkIntArray* owner);
+// The owner map attached to `mesh` when it has `voxels` tuples and was made for the mesh's points and
+// cells as they are now; else false (the caller rasterises).
+bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, std::vector<std::int32_t>& owner);
+// Removes the owner map from a copy that is no longer an image mesh (a labelled mesh, a moved one).
+void DropVoxelOwners(vtkDataObject* object);
+// A 64-bit digest of a grid's points and cells as stored.
+std::uint64_t MeshDigest(vtkUnstructuredGrid* grid);
 
 // Point arrays of a mesh whose first nIn points are the nodes of `in`: copied for those, and for the
 // nOut - nIn points added after them NodeType Added and Fixed 1 (ids below firstSteiner: box

@@ -160,8 +160,9 @@ int vtkImageMeshSmoothing::RequestData(
     const double smoothingSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
 
     t0 = Clock::now();
+    const vtkSmartPointer<vtkIntArray> owner = NewVoxelOwnerArray(geometry.Size());
     const ElementStatistics stats = ComputeElementStatistics(
-      ElementRasterizer(result.Mesh), values.data(), parallel, AlgorithmProgress(this, 0.6, 0.95));
+      ElementRasterizer(result.Mesh), values.data(), parallel, AlgorithmProgress(this, 0.6, 0.95), owner->GetPointer(0));
     if (stats.Aborted)
     {
       return 1;
@@ -170,6 +171,7 @@ int vtkImageMeshSmoothing::RequestData(
     this->UpdateProgress(0.97);
     const double statisticsSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
     WriteImageMesh(result.Mesh, stats, minAngle, radiusRatio, output);
+    AttachVoxelOwners(output, owner);
     PassNodeArrays(input->GetPointData(), nPts, output->GetPointData(), result.Mesh.NumberOfPoints(), nPts);
     const bool is2D = geometry.Is2D();
     AddFieldValue(output, is2D ? names::MinAngleBefore : names::MinDihedralAngleBefore, before);

@@ -131,6 +131,7 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
     // Output 1: the input with its points moved, the stale statistics dropped (the voxels an element
     // owns changed with it) and the quality recomputed; without VolumeMesh, the input.
     output->ShallowCopy(input);
+    DropVoxelOwners(output);
     // The input's points, the moved ones replaced (unmoved points keep their world coordinates bit
     // for bit).
     auto movedPoints = [&](const std::vector<std::array<double, 3>>& index) {

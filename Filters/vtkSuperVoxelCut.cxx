@@ -220,6 +220,13 @@ int vtkSuperVoxelCut::RequestData(
         return fail(error);
       }
       this->UpdateProgress(0.1);
+      // Stage 2's or 3's owner map, when it was made for this mesh in this frame.
+      ImageGeometry meshFrame;
+      std::string ignored;
+      if (ImageGeometryFromFieldData(input, meshFrame, ignored) && SameFrame(meshFrame, geometry))
+      {
+        AttachedVoxelOwners(input, geometry.Size(), prepared->Cut.Owner);
+      }
       if (!PrepareSuperVoxelCut(prepared->Mesh, valuesArray ? values.data() : nullptr, prepared->Cut, error,
             SMPParallelFor(), AlgorithmProgress(this, 0.1, 0.4)))
       {
@@ -243,7 +250,7 @@ int vtkSuperVoxelCut::RequestData(
       voxelValue = [valuesArray](std::int64_t v) { return valuesArray->GetComponent(v, 0); };
     }
     const SuperVoxelCutResult result = featuremesh::SuperVoxelCut(mesh, data.Cut, data.Mean, data.Count, objectVoxels,
-      backgroundVoxels, voxelValue, par, AlgorithmProgress(this, 0.45, 0.95), &data.Flow);
+      backgroundVoxels, voxelValue, par, parallel, AlgorithmProgress(this, 0.45, 0.95), &data.Flow);
     if (result.Aborted)
     {
       return 1;
@@ -257,6 +264,7 @@ int vtkSuperVoxelCut::RequestData(
 
     // Output 0: the mesh with labels.
     output->ShallowCopy(input);
+    DropVoxelOwners(output);
     vtkNew<vtkUnsignedCharArray> label;
     label->SetName(names::Label);
     label->SetNumberOfTuples(nCells);
@@ -269,11 +277,10 @@ int vtkSuperVoxelCut::RequestData(
 
     // Output 2: the labels on the image grid.
     SetImageFrame(labelImage, geometry);
-    const std::vector<std::uint8_t> voxelLabels = VoxelLabels(data.Cut.Owner, cut.Label, parallel);
     vtkNew<vtkUnsignedCharArray> voxels;
     voxels->SetName(names::Label);
     voxels->SetNumberOfTuples(geometry.Size());
-    std::copy(voxelLabels.begin(), voxelLabels.end(), voxels->GetPointer(0));
+    VoxelLabels(data.Cut.Owner, cut.Label, voxels->GetPointer(0), parallel);
     labelImage->GetPointData()->SetScalars(voxels);
     if (this->SuperVoxelIds)
     {

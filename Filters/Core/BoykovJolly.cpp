@@ -104,7 +104,7 @@ std::vector<double> SmoothedHistogram(
   return density;
 }
 
-bool GroupVoxelValues(const std::int64_t* owner, const double* values, std::int64_t voxels, std::int64_t nodes,
+bool GroupVoxelValues(const std::int32_t* owner, const double* values, std::int64_t voxels, std::int64_t nodes,
   NodeVoxelValues& grouped, std::string& error, const ParallelFor& parallel, const ProgressFunction& progress)
 {
   std::int64_t bad = 0;
@@ -357,26 +357,32 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   std::unique_ptr<double[]> regionObject(new double[n]), regionBackground(new double[n]);
   if (exact)
   {
-    // Each node's values are sorted and bin() is monotone: one binary search per bin a node spans.
+    // Each node's values are sorted and bin() is monotone: a node within one bin costs two reads,
+    // one spanning several a binary search per bin.
     const double* all = exact->Value.data();
-    for (std::int64_t p = 0; p < n; ++p)
+    const bool done = BatchedFor(n, 8192, pr.Parallel, SubProgress(progress, 0.2, 0.3), [&](std::int64_t first, std::int64_t last) {
+      for (std::int64_t p = first; p < last; ++p)
+      {
+        double sumObject = 0.0, sumBackground = 0.0;
+        for (const double *x = all + exact->Offset[p], *end = all + exact->Offset[p + 1]; x < end;)
+        {
+          const int b = bin(*x);
+          const double* next = b == r.Bins - 1 || bin(end[-1]) == b
+            ? end
+            : std::partition_point(x, end, [&](double y) { return bin(y) <= b; });
+          const double count = static_cast<double>(next - x);
+          sumObject += count * costObject[b];
+          sumBackground += count * costBackground[b];
+          x = next;
+        }
+        regionObject[p] = sumObject;
+        regionBackground[p] = sumBackground;
+      }
+    });
+    if (!done)
     {
-      double sumObject = 0.0, sumBackground = 0.0;
-      for (const double *x = all + exact->Offset[p], *end = all + exact->Offset[p + 1]; x < end;)
-      {
-        const int b = bin(*x);
-        const double* next = b == r.Bins - 1 ? end : std::partition_point(x, end, [&](double y) { return bin(y) <= b; });
-        const double count = static_cast<double>(next - x);
-        sumObject += count * costObject[b];
-        sumBackground += count * costBackground[b];
-        x = next;
-      }
-      regionObject[p] = sumObject;
-      regionBackground[p] = sumBackground;
-      if (aborted(p, n, 0.2, 0.3))
-      {
-        return r;
-      }
+      r.Aborted = true;
+      return r;
     }
   }
   else

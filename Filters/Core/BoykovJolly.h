@@ -47,7 +47,7 @@ struct NodeVoxelValues
 
 // Groups `voxels` values by their node (owner[v], -1 = none, in [-1, nodes)). False with a sentence
 // when a value is not finite or beyond +-1e150; false without one when progress asked to abort.
-bool GroupVoxelValues(const std::int64_t* owner, const double* values, std::int64_t voxels, std::int64_t nodes,
+bool GroupVoxelValues(const std::int32_t* owner, const double* values, std::int64_t voxels, std::int64_t nodes,
   NodeVoxelValues& grouped, std::string& error, const ParallelFor& parallel, const ProgressFunction& progress = NoProgress());
 
 struct CutProblem
@@ -62,6 +62,8 @@ struct CutProblem
   // over its voxel values x of -ln Pr(x | L) instead of Size_p * -ln Pr(Value_p | L). A mixed
   // element then costs what its voxels would cost in the voxel cut, rather than what its mean would.
   const NodeVoxelValues* NodeVoxels = nullptr;
+  // How loops over nodes may split across threads.
+  ParallelFor Parallel = SerialFor();
 };
 
 struct CutResult

@@ -50,7 +50,7 @@ template double InterpolateAt<double>(const double*, const ImageGeometry&, const
 template double InterpolateAt<float>(const float*, const ImageGeometry&, const double[3]);
 
 ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, const double* values,
-  const ParallelFor& parallel, const ProgressFunction& progress)
+  const ParallelFor& parallel, const ProgressFunction& progress, std::int32_t* owner)
 {
   const SimplexMesh& mesh = raster.Mesh();
   const auto& P = mesh.Points();
@@ -61,6 +61,10 @@ ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, cons
   s.Mean.assign(m, 0.0);
   s.StdDev.assign(m, 0.0);
   s.Interpolated.assign(m, 0);
+  if (owner)
+  {
+    std::fill(owner, owner + mesh.Geometry().Size(), -1);
+  }
   s.Aborted = !BatchedFor(m, 512, parallel, progress, [&](std::int64_t b, std::int64_t e) {
     for (std::int64_t c = b; c < e; ++c)
     {
@@ -69,6 +73,10 @@ ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, cons
       std::int64_t count = 0;
       double shift = 0.0, sum = 0.0, ss = 0.0;
       raster.ForEachVoxel(c, [&](std::int64_t v) {
+        if (owner)
+        {
+          owner[v] = static_cast<std::int32_t>(c);
+        }
         if (count == 0)
         {
           shift = values[v];
@@ -103,18 +111,18 @@ ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, cons
   return s;
 }
 
-std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const ParallelFor& parallel,
+std::vector<std::int32_t> VoxelOwners(const ElementRasterizer& raster, const ParallelFor& parallel,
   const ProgressFunction& progress)
 {
-  std::vector<std::int64_t> owner(raster.Mesh().Geometry().Size(), -1);
+  std::vector<std::int32_t> owner(raster.Mesh().Geometry().Size(), -1);
   // Each centre has exactly one owner, so the writes never collide.
   const bool done = BatchedFor(raster.NumberOfElements(), 512, parallel, progress, [&](std::int64_t b, std::int64_t e) {
     for (std::int64_t c = b; c < e; ++c)
     {
-      raster.ForEachVoxel(c, [&](std::int64_t v) { owner[v] = c; });
+      raster.ForEachVoxel(c, [&](std::int64_t v) { owner[v] = static_cast<std::int32_t>(c); });
     }
   });
-  return done ? owner : std::vector<std::int64_t>();
+  return done ? owner : std::vector<std::int32_t>();
 }
 
 namespace

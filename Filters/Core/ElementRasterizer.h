@@ -62,13 +62,14 @@ struct ElementStatistics
   std::vector<double> StdDev;
   std::vector<std::uint8_t> Interpolated;
 };
-// `values` has one value per voxel of the mesh's image.
+// `values` has one value per voxel of the mesh's image. `owner` (optional, one per voxel) receives
+// what VoxelOwners gives, from the same pass.
 ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, const double* values,
-  const ParallelFor& parallel, const ProgressFunction& progress = NoProgress());
+  const ParallelFor& parallel, const ProgressFunction& progress = NoProgress(), std::int32_t* owner = nullptr);
 
 // Owner element of every voxel (-1 where none, which only happens when the mesh does not tile the box).
-// Empty when progress asked to abort.
-std::vector<std::int64_t> VoxelOwners(const ElementRasterizer& raster, const ParallelFor& parallel,
+// Empty when progress asked to abort. Element ids are 32-bit: 4 bytes per voxel.
+std::vector<std::int32_t> VoxelOwners(const ElementRasterizer& raster, const ParallelFor& parallel,
   const ProgressFunction& progress = NoProgress());
 
 // Quality in frame (world) units: minimum angle (triangles) or minimum dihedral angle (tetrahedra)

@@ -7,7 +7,7 @@
 
 namespace featuremesh
 {
-bool SeedConstraints(const std::vector<std::int64_t>& owner, const std::vector<std::int64_t>& objectVoxels,
+bool SeedConstraints(const std::vector<std::int32_t>& owner, const std::vector<std::int64_t>& objectVoxels,
   const std::vector<std::int64_t>& backgroundVoxels, const char* node, std::vector<std::uint8_t>& hard,
   std::string& error)
 {
@@ -80,10 +80,13 @@ std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale)
 bool PrepareSuperVoxelCut(const SimplexMesh& mesh, const double* voxelValues, SuperVoxelCutData& data,
   std::string& error, const ParallelFor& parallel, const ProgressFunction& progress)
 {
-  data.Owner = VoxelOwners(ElementRasterizer(mesh), parallel, SubProgress(progress, 0.0, voxelValues ? 0.6 : 1.0));
-  if (data.Owner.empty())
+  if (static_cast<std::int64_t>(data.Owner.size()) != mesh.Geometry().Size())
   {
-    return false;
+    data.Owner = VoxelOwners(ElementRasterizer(mesh), parallel, SubProgress(progress, 0.0, voxelValues ? 0.6 : 1.0));
+    if (data.Owner.empty())
+    {
+      return false;
+    }
   }
   return !voxelValues ||
     GroupVoxelValues(data.Owner.data(), voxelValues, mesh.Geometry().Size(), mesh.NumberOfElements(), data.Voxels,
@@ -93,13 +96,14 @@ bool PrepareSuperVoxelCut(const SimplexMesh& mesh, const double* voxelValues, Su
 SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutData& data, const std::vector<double>& mean,
   const std::vector<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
   const std::vector<std::int64_t>& backgroundVoxels, const VoxelValueFunction& voxelValue,
-  const SuperVoxelCutParameters& parameters, const ProgressFunction& progress, MaxFlowCache* flow)
+  const SuperVoxelCutParameters& parameters, const ParallelFor& parallel, const ProgressFunction& progress,
+  MaxFlowCache* flow)
 {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   SuperVoxelCutResult result;
   const std::int64_t m = mesh.NumberOfElements();
-  const std::vector<std::int64_t>& owner = data.Owner;
+  const std::vector<std::int32_t>& owner = data.Owner;
   if (static_cast<std::int64_t>(owner.size()) != mesh.Geometry().Size() ||
     (data.HasVoxelValues() && static_cast<std::int64_t>(data.Voxels.Offset.size()) != m + 1))
   {
@@ -115,6 +119,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   }
   pr.Value = mean;
   pr.Size = voxelCount;
+  pr.Parallel = parallel;
   const FaceAdjacency& adj = mesh.Faces();
   pr.A = adj.A;
   pr.B = adj.B;
@@ -176,17 +181,15 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   return result;
 }
 
-std::vector<std::uint8_t> VoxelLabels(const std::vector<std::int64_t>& owner, const std::vector<std::uint8_t>& label,
+void VoxelLabels(const std::vector<std::int32_t>& owner, const std::vector<std::uint8_t>& label, std::uint8_t* out,
   const ParallelFor& parallel)
 {
-  std::vector<std::uint8_t> out(owner.size());
   parallel(static_cast<std::int64_t>(owner.size()), 65536, [&](std::int64_t b, std::int64_t e) {
     for (std::int64_t v = b; v < e; ++v)
     {
       out[v] = owner[v] >= 0 ? label[owner[v]] : 0;
     }
   });
-  return out;
 }
 
 std::string ValidateParameters(const SeededCutParameters& p)

@@ -55,7 +55,7 @@ struct SuperVoxelCutResult
 // Hard constraints (0 free, 1 object, 2 background) of the nodes owning the seed voxels; false
 // with a sentence when a seed voxel has no owner (-1) or a node holds seeds of both kinds.
 // `node` names a node in messages ("element", "voxel").
-bool SeedConstraints(const std::vector<std::int64_t>& owner, const std::vector<std::int64_t>& objectVoxels,
+bool SeedConstraints(const std::vector<std::int32_t>& owner, const std::vector<std::int64_t>& objectVoxels,
   const std::vector<std::int64_t>& backgroundVoxels, const char* node, std::vector<std::uint8_t>& hard,
   std::string& error);
 
@@ -68,14 +68,14 @@ std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale);
 struct SuperVoxelCutData
 {
   // The element owning each voxel (VoxelOwners, ElementRasterizer.h; -1 none).
-  std::vector<std::int64_t> Owner;
+  std::vector<std::int32_t> Owner;
   // Each element's voxel values; empty without voxel values.
   NodeVoxelValues Voxels;
   bool HasVoxelValues() const { return !this->Voxels.Offset.empty(); }
 };
 
-// Rasterises the mesh and groups `voxelValues` (optional, one per voxel of the mesh's image) by
-// element. False with a sentence for a bad value, without one when progress asked to abort.
+// Rasterises the mesh, unless `data.Owner` already holds its owners (stage 2's, say), and groups
+// `voxelValues` (optional, one per voxel of the mesh's image) by element. False with a sentence for a bad value, without one when progress asked to abort.
 bool PrepareSuperVoxelCut(const SimplexMesh& mesh, const double* voxelValues, SuperVoxelCutData& data,
   std::string& error, const ParallelFor& parallel, const ProgressFunction& progress = NoProgress());
 
@@ -90,10 +90,11 @@ using VoxelValueFunction = std::function<double(std::int64_t)>;
 SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutData& data, const std::vector<double>& mean,
   const std::vector<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
   const std::vector<std::int64_t>& backgroundVoxels, const VoxelValueFunction& voxelValue,
-  const SuperVoxelCutParameters& parameters, const ProgressFunction& progress = NoProgress(), MaxFlowCache* flow = nullptr);
+  const SuperVoxelCutParameters& parameters, const ParallelFor& parallel, const ProgressFunction& progress = NoProgress(),
+  MaxFlowCache* flow = nullptr);
 
-// The labels of the elements on the voxel grid (0 where no element owns a voxel).
-std::vector<std::uint8_t> VoxelLabels(const std::vector<std::int64_t>& owner, const std::vector<std::uint8_t>& label,
+// The labels of the elements on the voxel grid, into `out` (one per owner; 0 where no element owns a voxel).
+void VoxelLabels(const std::vector<std::int32_t>& owner, const std::vector<std::uint8_t>& label, std::uint8_t* out,
   const ParallelFor& parallel);
 
 // The voxel cut on the 4-/6-connected grid, each neighbour pair one voxel face; `values` (one per

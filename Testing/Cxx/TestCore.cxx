@@ -410,7 +410,7 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
 {
   // Super-nodes of one voxel each: the voxel region term must equal the mean-based one.
   std::vector<double> pixels;
-  std::vector<std::int64_t> owner;
+  std::vector<std::int32_t> owner;
   for (int i = 0; i < 30; ++i)
   {
     pixels.push_back((i < 12 ? 10.0 : 0.0) + ((i * 7) % 5) * 0.6);
@@ -439,7 +439,7 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   two.B = { 2, 2 };
   two.Contact = { 0.01, 0.01 };
   const std::vector<double> v = { 10.0, 0.0, 10.0, 10.0, 10.0, 0.0 };
-  const std::vector<std::int64_t> o = { 0, 1, 2, 2, 2, 2 };
+  const std::vector<std::int32_t> o = { 0, 1, 2, 2, 2, 2 };
   two.ObjectSamples = { 10.0, 9.0, 11.0 };
   two.BackgroundSamples = { 0.0, 1.0, -1.0 };
   NodeVoxelValues twoGrouped;
@@ -558,7 +558,7 @@ TEST(SuperVoxelCut, ContactAndHardConstraintsOnFourTriangles)
   SuperVoxelCutData data;
   std::string prepareError;
   ASSERT_TRUE(PrepareSuperVoxelCut(mesh, nullptr, data, prepareError, SerialFor()));
-  const std::vector<std::int64_t>& owner = data.Owner;
+  const std::vector<std::int32_t>& owner = data.Owner;
   const ImageGeometry& g = mesh.Geometry();
   std::vector<std::uint8_t> hard(4, 0);
   std::string error;
@@ -574,12 +574,13 @@ TEST(SuperVoxelCut, ContactAndHardConstraintsOnFourTriangles)
   const std::vector<double> mean = { 100, 10, 10, 100 }, count = { 9, 9, 9, 9 };
   SuperVoxelCutParameters par;
   const SuperVoxelCutResult r =
-    SuperVoxelCut(mesh, data, mean, count, { g.Index(2, 0, 0) }, { g.Index(4, 2, 0) }, VoxelValueFunction(), par);
+    SuperVoxelCut(mesh, data, mean, count, { g.Index(2, 0, 0) }, { g.Index(4, 2, 0) }, VoxelValueFunction(), par, SerialFor());
   ASSERT_TRUE(r.Error.empty()) << r.Error;
   EXPECT_EQ(r.Cut.Label[0], LabelObject);
   EXPECT_EQ(r.Cut.Label[1], LabelBackground);
   EXPECT_EQ(r.Cut.Label[3], LabelObject);
-  const std::vector<std::uint8_t> voxels = VoxelLabels(owner, r.Cut.Label, SerialFor());
+  std::vector<std::uint8_t> voxels(owner.size());
+  VoxelLabels(owner, r.Cut.Label, voxels.data(), SerialFor());
   EXPECT_EQ(voxels[g.Index(2, 0, 0)], LabelObject);
   EXPECT_EQ(voxels[g.Index(4, 2, 0)], LabelBackground);
 }

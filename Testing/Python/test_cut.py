@@ -120,6 +120,22 @@ for step, change in (("a seed edit", lambda: setattr(edited, "Points", points[3:
              "after %s the kept cut equals a fresh one (%d elements)" % (step, a.GetNumberOfCells()))
     ft.Delete(fresh)
 
+# Stage 2's owner map (field data VoxelOwner + digest) is what the cut would rasterise: on the lattice
+# mesh of nuclei the cut with it and one made to rasterise (digest removed) give the same element
+# ids; the labelled mesh does not carry the map.
+d, image, truth, so, sb, cut = run("nuclei-dsb2018")
+fd = ft.fetch(cut.Mesh).GetFieldData()
+owner_map = fd.GetArray("VoxelOwner")
+ft.check(owner_map is not None and owner_map.GetNumberOfTuples() == ft.fetch(image).GetNumberOfPoints() and
+         fd.GetArray("VoxelOwnerDigest") is not None, "Delaunay Image Mesh attaches a VoxelOwner map of one id per voxel")
+strip = ft.ProgrammableFilter(Input=cut.Mesh, OutputDataSetType="vtkUnstructuredGrid",
+                              Script="self.GetOutput().ShallowCopy(self.GetInput()); self.GetOutput().GetFieldData().RemoveArray('VoxelOwnerDigest')")
+ids = [ft.SuperVoxelCut(Mesh=m, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, SuperVoxelIds=1) for m in (cut.Mesh, strip)]
+a, b = (ft.array(ft.fetch(c, 2), "ElementId") for c in ids)
+ft.check(ft.np.array_equal(a, b) and ft.np.array_equal(ft.v2n(owner_map), a),
+         "the attached owner map equals the cut's own rasterisation (%d voxels)" % a.size)
+ft.check(ft.fetch(cut).GetFieldData().GetArray("VoxelOwner") is None, "the labelled mesh does not carry the owner map")
+
 # A chain of seed edits reuses the last max-flow (Kohli-Torr): after each, labels and flow equal a
 # fresh cut's. The edits move a seed by a voxel and back, onto another element, add and drop seeds.
 for case in ("nuclei-dsb2018", "liver-ct-totalseg"):
