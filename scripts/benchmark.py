@@ -10,9 +10,13 @@ The pipeline is stages 1 -> 2 -> 3 -> 4 at their defaults (Feature Nodes, Delaun
 Image Mesh Smoothing, Super-Voxel Cut); a quality table gives the minimum and maximum (dihedral)
 angle of the Delaunay mesh and of the smoothed one, and the nodes smoothing added.
 
-Segmentation table: Dice and seconds of the pipeline (median of --runs fresh runs per stage), the
-re-cut after a seed edit (recut_s: the first object seed moved by one voxel, only the cut re-run), the
-voxel cut (once when it takes over 5 s), scikit-image's random walker (image mapped to [0, 1] by its
+Speed table: each stage's seconds and the pipeline's (median of --runs fresh runs per stage), the voxel
+cut's (once when it takes over 5 s) and their ratio; in 3D the classic pipeline a user would otherwise
+run, the voxel cut then CGAL Mesh_3 on its labels (FeatureMeshClassicMesh3, built with the tests;
+facet distance 2, object and background meshed), and its ratio; the re-cut after a seed edit (recut_s:
+the first object seed moved by one voxel, only the cut re-run) and the voxel cut's ratio to it.
+
+Segmentation table: Dice of the pipeline, the voxel cut, scikit-image's random walker (image mapped to [0, 1] by its
 0.5/99.5 percentiles, so that one beta means the same on every image: 2e5, featuremesh.metrics; over 2 M voxels on 2 x 2 x 2
 block means, random_walker_scale 2) and a seeded watershed on
 the gradient magnitude (sigma 1 voxel) of that image; the peers get the same seed voxels.
@@ -30,7 +34,9 @@ import csv
 import os
 import platform
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -68,6 +74,20 @@ def timed(proxy):
     t = time.perf_counter()
     proxy.UpdatePipeline()
     return time.perf_counter() - t
+
+
+def classic_mesh3(labels, image):
+    """Seconds of CGAL Mesh_3 on a voxel cut's labels (FeatureMeshClassicMesh3, built with the tests;
+    object and background both meshed, facet distance 2), or None when the program is absent."""
+    exe = os.environ.get("FEATUREMESH_CLASSIC_MESH3", os.path.join(fm.ROOT, "build", "Testing", "FeatureMeshClassicMesh3"))
+    if not os.path.exists(exe):
+        print("classic pipeline: %s not found (build the tests)" % exe)
+        return None
+    with tempfile.NamedTemporaryFile(suffix=".raw") as f:
+        labels.astype(np.uint8).tofile(f.name)
+        args = [exe, f.name] + [str(d) for d in image.GetDimensions()] + [str(abs(s)) for s in image.GetSpacing()] + ["2"]
+        out = subprocess.run(args, capture_output=True, text=True, check=True).stdout.split()
+    return float(out[out.index("seconds") + 1])
 
 
 def run_case(case, args):
@@ -112,6 +132,8 @@ def run_case(case, args):
     V = fm.labels(vc, 0)
     med = {k: statistics.median(v) for k, v in times.items()}
     total = sum(med.values())
+    # The classic pipeline (3D): the voxel cut, then CGAL Mesh_3 on its labels.
+    mesh3 = classic_mesh3(V, image) if dims[2] > 1 else None
     raw = fm.fetch(delaunay)
     q0 = metrics.mesh_quality(v2n(raw.GetPoints().GetData()), cells_of(raw))
     q1 = metrics.mesh_quality(v2n(labelled.GetPoints().GetData()), cells_of(labelled))
@@ -119,12 +141,15 @@ def run_case(case, args):
            "elements_with_voxels": int((v2n(labelled.GetCellData().GetArray("PixelCount")) > 0).sum()),
            "nodes_s": med["nodes"], "mesh_s": med["mesh"], "smoothing_s": med["smoothing"], "cut_s": med["cut"], "total_s": total,
            "voxel_cut_s": statistics.median(vt), "speedup": statistics.median(vt) / total,
-           "recut_s": statistics.median(rt),
+           "recut_s": statistics.median(rt), "recut_speedup": statistics.median(vt) / statistics.median(rt),
            "dice_supervoxel": fm.dice(L, T), "dice_voxel": fm.dice(V, T),
            "components": int(field(labelled, "ObjectComponents")[0]),
            "added_nodes_pct": 100.0 * float(field(labelled, "AddedNodes")[0]) / raw.GetNumberOfPoints(),
            "min_angle_delaunay": q0["min"], "min_angle_smoothed": q1["min"],
            "max_angle_delaunay": q0["max"], "max_angle_smoothed": q1["max"]}
+    if mesh3 is not None:
+        row.update({"mesh3_s": mesh3, "classic_s": row["voxel_cut_s"] + mesh3,
+                    "classic_speedup": (row["voxel_cut_s"] + mesh3) / total})
     unit = metrics.unit_range(v2n(image.GetPointData().GetScalars()).reshape(shape))
     if not args.no_peers:
         obj, bg = seed_indices(case, image)
@@ -205,12 +230,16 @@ def main():
         w.writeheader()
         w.writerows(rows)
     machine = "%s, %d cores, %s" % (platform.machine(), os.cpu_count(), platform.platform())
-    seg = [k for k in keys if k in ("case", "voxels", "elements", "total_s", "voxel_cut_s", "speedup", "recut_s", "components")
-           or k.startswith("dice_") or k.endswith(("walker_s", "shed_s", "_scale"))]
+    seg = [k for k in keys if k in ("case", "components") or k.startswith("dice_") or k.endswith(("walker_s", "shed_s", "_scale"))]
+    speed = [k for k in keys if k in ("case", "voxels", "elements", "nodes_s", "mesh_s", "smoothing_s", "cut_s", "total_s",
+                                      "voxel_cut_s", "speedup", "mesh3_s", "classic_s", "classic_speedup", "recut_s",
+                                      "recut_speedup")]
     mq = [k for k in keys if k in ("case", "mesh_s", "smoothing_s", "added_nodes_pct") or k.startswith(("min_angle", "max_angle"))]
     sp = [k for k in keys if k == "case" or k == "K" or k.startswith(("oracle_", "asa_", "boundary_", "slic_"))]
     lines = ["Machine: %s; medians of %d runs (voxel cut: once when over 5 s)." % (machine, args.runs), "",
-             "## Segmentation (Dice at the defaults)", ""] + markdown(rows, seg)
+             "## Speed (seconds; speedup = voxel cut / pipeline, classic = voxel cut + CGAL Mesh_3 of its labels, "
+             "recut = the cut after a seed edit)", ""] + markdown(rows, speed)
+    lines += ["", "## Segmentation (Dice at the defaults)", ""] + markdown(rows, seg)
     lines += ["", "## Mesh quality: Delaunay Image Mesh, then Image Mesh Smoothing (angles in degrees; 3D dihedral)", ""]
     lines += markdown(rows, mq)
     if len(sp) > 1:

@@ -16,12 +16,12 @@ script = os.path.join(ft.fm.ROOT, "scripts", "benchmark.py")
 run = subprocess.run([shutil.which("pvpython"), script, "--runs", "1", "--out", out], env=env, capture_output=True, text=True)
 print(run.stdout[-3000:])
 ft.check(run.returncode == 0, "benchmark.py exits 0 (stderr: %s)" % run.stderr[-500:])
-ft.check("## Mesh quality" in run.stdout and "## The mesh as super-pixels" in run.stdout and "dice_random_walker" in run.stdout and "dice_watershed" in run.stdout,
+ft.check("## Speed" in run.stdout and "## Mesh quality" in run.stdout and "## The mesh as super-pixels" in run.stdout and "dice_random_walker" in run.stdout and "dice_watershed" in run.stdout,
          "the printed tables hold the super-pixel table and the peer columns")
 rows = list(csv.DictReader(open(out + ".csv"))) if os.path.isfile(out + ".csv") else []
 ft.check(sorted(r["case"] for r in rows) == ["liver-ct-totalseg", "nuclei-dsb2018"], "both bundled cases in the CSV")
 for r in rows:
-    v = {k: float(x) for k, x in r.items() if k not in ("case", "slic_bracket")}
+    v = {k: float(x) for k, x in r.items() if k not in ("case", "slic_bracket") and x != ""}
     scores = [v[k] for k in v if k.startswith(("dice_", "oracle_", "asa_", "boundary_recall_"))]
     ft.check(all(0.0 <= s <= 1.0 for s in scores), "%s: every score in [0, 1]" % r["case"])
     ft.check(v["oracle_dice_mesh"] >= v["dice_supervoxel"] - 1e-9,
@@ -31,6 +31,13 @@ for r in rows:
     low, high = (int(x) if x != "None" else None for x in r["slic_bracket"].split("-"))
     ft.check(low is not None and high is not None and low <= v["K"] <= high,
              "%s: SLIC runs bracket K (%s)" % (r["case"], r["slic_bracket"]))
+    ft.check(abs(v["speedup"] - v["voxel_cut_s"] / v["total_s"]) < 1e-6 * v["speedup"] and
+             abs(v["total_s"] - sum(v[k] for k in ("nodes_s", "mesh_s", "smoothing_s", "cut_s"))) < 1e-9 and
+             abs(v["recut_speedup"] - v["voxel_cut_s"] / v["recut_s"]) < 1e-6 * v["recut_speedup"],
+             "%s: the speed table's total and ratios follow from its times" % r["case"])
+    if r["case"] == "liver-ct-totalseg":
+        ft.check(v.get("mesh3_s", 0) > 0 and abs(v["classic_s"] - v["voxel_cut_s"] - v["mesh3_s"]) < 1e-9,
+                 "%s: the classic pipeline (voxel cut %.2f s + CGAL Mesh_3 %.2f s) is timed" % (r["case"], v["voxel_cut_s"], v.get("mesh3_s", 0)))
     ft.check(v["components"] >= 1, "%s: object components reported" % r["case"])
     ft.check(v["min_angle_smoothed"] > v["min_angle_delaunay"] and v["smoothing_s"] > 0,
              "%s: the pipeline smooths the mesh: min angle %.2f -> %.2f" % (r["case"], v["min_angle_delaunay"], v["min_angle_smoothed"]))
