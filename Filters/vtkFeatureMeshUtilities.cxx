@@ -434,8 +434,9 @@ constexpr double LargestValue()
   return sizeof(T) == sizeof(float) ? 3.4028234663852886e38 : 1e150;
 }
 
+// With `values` null, only checks.
 template <typename T>
-bool ToValues(vtkDataArray* array, std::vector<T>& values, std::string& error)
+bool ToValues(vtkDataArray* array, std::vector<T>* values, std::string& error)
 {
   if (!array)
   {
@@ -450,7 +451,10 @@ bool ToValues(vtkDataArray* array, std::vector<T>& values, std::string& error)
     return false;
   }
   const vtkIdType n = array->GetNumberOfTuples();
-  values.resize(static_cast<size_t>(n));
+  if (values)
+  {
+    values->resize(static_cast<size_t>(n));
+  }
   std::vector<vtkIdType> badPerBlock(64, 0);
   const vtkIdType block = (n + 63) / 64;
   auto convert = [&](auto* data) {
@@ -459,13 +463,16 @@ bool ToValues(vtkDataArray* array, std::vector<T>& values, std::string& error)
       {
         // A local count and a raw pointer let the compiler vectorise the conversion.
         vtkIdType bad = 0;
-        T* out = values.data();
+        T* out = values ? values->data() : nullptr;
         for (vtkIdType i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
         {
           const double v = static_cast<double>(data[i]);
           const bool ok = std::isfinite(v) && std::fabs(v) <= LargestValue<T>();
           bad += ok ? 0 : 1;
-          out[i] = ok ? static_cast<T>(v) : T(0);
+          if (out)
+          {
+            out[i] = ok ? static_cast<T>(v) : T(0);
+          }
         }
         badPerBlock[b] = bad;
       }
@@ -496,7 +503,7 @@ bool ToValues(vtkDataArray* array, std::vector<T>& values, std::string& error)
 
 bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error)
 {
-  return ToValues(array, values, error);
+  return ToValues(array, &values, error);
 }
 
 const float* FloatValues(vtkDataArray* array, std::vector<float>& storage, std::string& error)
@@ -603,7 +610,12 @@ bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, std::ve
 
 bool ToDouble(vtkDataArray* array, std::vector<double>& values, std::string& error)
 {
-  return ToValues(array, values, error);
+  return ToValues(array, &values, error);
+}
+
+bool CheckDouble(vtkDataArray* array, std::string& error)
+{
+  return ToValues<double>(array, nullptr, error);
 }
 
 vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::string& error, std::string& warning)

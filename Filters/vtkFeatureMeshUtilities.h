@@ -156,6 +156,8 @@ void RequestWholeImage(vtkInformationVector* portVector);
 
 // Copies a one-component array to double, rejecting NaN/Inf.
 bool ToDouble(vtkDataArray* array, std::vector<double>& values, std::string& error);
+// What ToDouble checks, without the copy (a stage that reads the array in its own type).
+bool CheckDouble(vtkDataArray* array, std::string& error);
 
 // Copies a one-component array to float, rejecting NaN/Inf (error names how many).
 bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error);

@@ -188,11 +188,11 @@ int vtkSuperVoxelCut::RequestData(
     }
     // The mesh-dependent data: kept from the last run when the mesh, the image and its array are
     // the same objects, unmodified (a seed edit).
-    const MeshData key({ input->GetPoints(), input->GetCells(), meanArray, countArray, valuesArray }, geometry);
+    MeshData key({ input->GetPoints(), input->GetCells(), meanArray, countArray, valuesArray }, geometry);
     if (!this->Prepared || !this->Prepared->SameInputs(key))
     {
       this->Prepared.reset();
-      auto prepared = std::make_unique<MeshData>(key);
+      auto prepared = std::make_unique<MeshData>(std::move(key));
       if (!ToSimplexMesh(input, geometry, prepared->Mesh, error))
       {
         return fail(error);
@@ -214,8 +214,8 @@ int vtkSuperVoxelCut::RequestData(
           std::to_string(badMean ? badMean : badCount) +
           (badMean ? " NaN or infinite values" : " negative or non-finite values") + "; recompute the mesh with Delaunay Image Mesh.");
       }
-      std::vector<double> values;
-      if (valuesArray && !ToDouble(valuesArray, values, error))
+      // The image is read in its own type (checked as ToDouble would, without the copy).
+      if (valuesArray && !CheckDouble(valuesArray, error))
       {
         return fail(error);
       }
@@ -227,8 +227,23 @@ int vtkSuperVoxelCut::RequestData(
       {
         AttachedVoxelOwners(input, geometry.Size(), prepared->Cut.Owner);
       }
-      if (!PrepareSuperVoxelCut(prepared->Mesh, valuesArray ? values.data() : nullptr, prepared->Cut, error,
-            SMPParallelFor(), AlgorithmProgress(this, 0.1, 0.4)))
+      const ProgressFunction progress = AlgorithmProgress(this, 0.1, 0.4);
+      bool ready = false;
+      if (!valuesArray)
+      {
+        ready = PrepareSuperVoxelCut(prepared->Mesh, static_cast<const double*>(nullptr), prepared->Cut, error, SMPParallelFor(), progress);
+      }
+      else
+      {
+        switch (valuesArray->GetDataType())
+        {
+          vtkTemplateMacro(ready = PrepareSuperVoxelCut(prepared->Mesh, static_cast<const VTK_TT*>(valuesArray->GetVoidPointer(0)),
+                             prepared->Cut, error, SMPParallelFor(), progress));
+          default:
+            error = "the array's value type is not supported.";
+        }
+      }
+      if (!ready)
       {
         return error.empty() ? 1 : fail(error); // aborted, or a bad value
       }

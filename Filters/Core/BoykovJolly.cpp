@@ -15,7 +15,8 @@ namespace
 {
 // Percentile of at most ~1 M evenly strided values: exact enough for a histogram range, and a
 // 9 M-voxel volume is not copied and partially sorted twice.
-double Percentile(const double* data, std::int64_t n, double q)
+template <typename T>
+double Percentile(const T* data, std::int64_t n, double q)
 {
   if (n <= 0)
   {
@@ -26,7 +27,7 @@ double Percentile(const double* data, std::int64_t n, double q)
   v.reserve(static_cast<size_t>(n / stride + 1));
   for (std::int64_t i = 0; i < n; i += stride)
   {
-    v.push_back(data[i]);
+    v.push_back(static_cast<double>(data[i]));
   }
   const size_t k = std::min(v.size() - 1, static_cast<size_t>(q / 100.0 * static_cast<double>(v.size() - 1) + 0.5));
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
@@ -104,14 +105,31 @@ std::vector<double> SmoothedHistogram(
   return density;
 }
 
-bool GroupVoxelValues(const std::int32_t* owner, const double* values, std::int64_t voxels, std::int64_t nodes,
+template <typename T>
+bool GroupVoxelValues(const std::int32_t* owner, const T* values, std::int64_t voxels, std::int64_t nodes,
   NodeVoxelValues& grouped, std::string& error, const ParallelFor& parallel, const ProgressFunction& progress)
 {
-  std::int64_t bad = 0;
-  for (std::int64_t v = 0; v < voxels; ++v)
-  {
-    bad += std::isfinite(values[v]) && std::fabs(values[v]) <= 1e150 ? 0 : 1;
-  }
+  // A counting sort by node in a fixed number of voxel chunks (whatever the threads): chunk c's
+  // voxels of node p go after those of chunks before c, so each node's voxels stay in raster order
+  // and the result does not depend on how the work is split. Then each node's values are sorted.
+  constexpr std::int64_t chunks = 4;
+  const std::int64_t size = (voxels + chunks - 1) / chunks;
+  std::vector<std::int64_t> cursor(static_cast<size_t>(chunks * nodes), 0), badPerChunk(chunks, 0);
+  parallel(chunks, 1, [&](std::int64_t c0, std::int64_t c1) {
+    for (std::int64_t c = c0; c < c1; ++c)
+    {
+      std::int64_t* count = cursor.data() + c * nodes;
+      std::int64_t bad = 0;
+      for (std::int64_t v = c * size, e = std::min(voxels, (c + 1) * size); v < e; ++v)
+      {
+        const double x = static_cast<double>(values[v]);
+        bad += std::isfinite(x) && std::fabs(x) <= 1e150 ? 0 : 1;
+        count[owner[v]] += owner[v] >= 0 ? 1 : 0;
+      }
+      badPerChunk[c] = bad;
+    }
+  });
+  const std::int64_t bad = std::accumulate(badPerChunk.begin(), badPerChunk.end(), std::int64_t(0));
   if (bad)
   {
     error = std::to_string(bad) + " intensities are NaN, infinite or beyond +-1e150; replace or rescale them (e.g. with a Calculator) first.";
@@ -119,40 +137,67 @@ bool GroupVoxelValues(const std::int32_t* owner, const double* values, std::int6
   }
   grouped.Low = Percentile(values, voxels, 0.5);
   grouped.High = Percentile(values, voxels, 99.5);
-  if (!progress(0.2))
+  if (!progress(0.3))
   {
     return false;
   }
-  // A counting sort by node keeps each node's voxels in raster order; sorting them is per node.
   grouped.Offset.assign(nodes + 1, 0);
-  for (std::int64_t v = 0; v < voxels; ++v)
-  {
-    grouped.Offset[owner[v] + 1] += owner[v] >= 0 ? 1 : 0;
-  }
+  std::int64_t total = 0;
   for (std::int64_t p = 0; p < nodes; ++p)
   {
-    grouped.Offset[p + 1] += grouped.Offset[p];
+    grouped.Offset[p] = total;
+    for (std::int64_t c = 0; c < chunks; ++c)
+    {
+      const std::int64_t n = cursor[c * nodes + p];
+      cursor[c * nodes + p] = total;
+      total += n;
+    }
   }
-  grouped.Value.resize(grouped.Offset[nodes]);
-  std::vector<std::int64_t> cursor(grouped.Offset.begin(), grouped.Offset.end() - 1);
-  if (!progress(0.4))
+  grouped.Offset[nodes] = total;
+  // Not zero-filled: every element is written below (a 9 M-voxel volume's 71 MB would be written twice).
+  grouped.Value.reset(new double[total]);
+  double* out = grouped.Value.get();
+  parallel(chunks, 1, [&](std::int64_t c0, std::int64_t c1) {
+    for (std::int64_t c = c0; c < c1; ++c)
+    {
+      std::int64_t* next = cursor.data() + c * nodes;
+      for (std::int64_t v = c * size, e = std::min(voxels, (c + 1) * size); v < e; ++v)
+      {
+        if (owner[v] >= 0)
+        {
+          out[next[owner[v]]++] = static_cast<double>(values[v]);
+        }
+      }
+    }
+  });
+  if (!progress(0.6))
   {
     return false;
-  }
-  for (std::int64_t v = 0; v < voxels; ++v)
-  {
-    if (owner[v] >= 0)
-    {
-      grouped.Value[cursor[owner[v]]++] = values[v];
-    }
   }
   return BatchedFor(nodes, 4096, parallel, SubProgress(progress, 0.6, 1.0), [&](std::int64_t b, std::int64_t e) {
     for (std::int64_t p = b; p < e; ++p)
     {
-      std::sort(grouped.Value.begin() + grouped.Offset[p], grouped.Value.begin() + grouped.Offset[p + 1]);
+      std::sort(out + grouped.Offset[p], out + grouped.Offset[p + 1]);
     }
   });
 }
+#define FEATUREMESH_GROUP_VOXEL_VALUES(T)                                                                        \
+  template bool GroupVoxelValues<T>(const std::int32_t*, const T*, std::int64_t, std::int64_t, NodeVoxelValues&, \
+    std::string&, const ParallelFor&, const ProgressFunction&);
+FEATUREMESH_GROUP_VOXEL_VALUES(float)
+FEATUREMESH_GROUP_VOXEL_VALUES(double)
+FEATUREMESH_GROUP_VOXEL_VALUES(char)
+FEATUREMESH_GROUP_VOXEL_VALUES(signed char)
+FEATUREMESH_GROUP_VOXEL_VALUES(unsigned char)
+FEATUREMESH_GROUP_VOXEL_VALUES(short)
+FEATUREMESH_GROUP_VOXEL_VALUES(unsigned short)
+FEATUREMESH_GROUP_VOXEL_VALUES(int)
+FEATUREMESH_GROUP_VOXEL_VALUES(unsigned int)
+FEATUREMESH_GROUP_VOXEL_VALUES(long)
+FEATUREMESH_GROUP_VOXEL_VALUES(unsigned long)
+FEATUREMESH_GROUP_VOXEL_VALUES(long long)
+FEATUREMESH_GROUP_VOXEL_VALUES(unsigned long long)
+#undef FEATUREMESH_GROUP_VOXEL_VALUES
 
 namespace
 {
@@ -182,8 +227,7 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
   if ((!pr.Size.empty() && static_cast<std::int64_t>(pr.Size.size()) != n) ||
     static_cast<std::int64_t>(pr.Hard.size()) != n || static_cast<std::int64_t>(pr.B.size()) != m ||
     (!pr.Contact.empty() && static_cast<std::int64_t>(pr.Contact.size()) != m) ||
-    (pr.NodeVoxels && (static_cast<std::int64_t>(pr.NodeVoxels->Offset.size()) != n + 1 ||
-                        pr.NodeVoxels->Offset.back() != static_cast<std::int64_t>(pr.NodeVoxels->Value.size()))))
+    (pr.NodeVoxels && (static_cast<std::int64_t>(pr.NodeVoxels->Offset.size()) != n + 1 || !pr.NodeVoxels->Value)))
   {
     return "the graph's arrays disagree in length.";
   }
@@ -359,7 +403,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   {
     // Each node's values are sorted and bin() is monotone: a node within one bin costs two reads,
     // one spanning several a binary search per bin.
-    const double* all = exact->Value.data();
+    const double* all = exact->Value.get();
     const bool done = BatchedFor(n, 8192, pr.Parallel, SubProgress(progress, 0.2, 0.3), [&](std::int64_t first, std::int64_t last) {
       for (std::int64_t p = first; p < last; ++p)
       {

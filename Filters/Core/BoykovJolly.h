@@ -41,13 +41,15 @@ struct BoykovJollyParameters
 struct NodeVoxelValues
 {
   std::vector<std::int64_t> Offset;
-  std::vector<double> Value;
+  std::unique_ptr<double[]> Value;
   double Low = 0.0, High = 0.0;
 };
 
-// Groups `voxels` values by their node (owner[v], -1 = none, in [-1, nodes)). False with a sentence
-// when a value is not finite or beyond +-1e150; false without one when progress asked to abort.
-bool GroupVoxelValues(const std::int32_t* owner, const double* values, std::int64_t voxels, std::int64_t nodes,
+// Groups `voxels` values (of any arithmetic type: an image in its own type) by their node
+// (owner[v], -1 = none, in [-1, nodes)). False with a sentence when a value is not finite or beyond
+// +-1e150; false without one when progress asked to abort.
+template <typename T>
+bool GroupVoxelValues(const std::int32_t* owner, const T* values, std::int64_t voxels, std::int64_t nodes,
   NodeVoxelValues& grouped, std::string& error, const ParallelFor& parallel, const ProgressFunction& progress = NoProgress());
 
 struct CutProblem

@@ -77,20 +77,14 @@ std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale)
   return contact;
 }
 
-bool PrepareSuperVoxelCut(const SimplexMesh& mesh, const double* voxelValues, SuperVoxelCutData& data,
-  std::string& error, const ParallelFor& parallel, const ProgressFunction& progress)
+bool PrepareVoxelOwners(const SimplexMesh& mesh, SuperVoxelCutData& data, const ParallelFor& parallel,
+  const ProgressFunction& progress)
 {
   if (static_cast<std::int64_t>(data.Owner.size()) != mesh.Geometry().Size())
   {
-    data.Owner = VoxelOwners(ElementRasterizer(mesh), parallel, SubProgress(progress, 0.0, voxelValues ? 0.6 : 1.0));
-    if (data.Owner.empty())
-    {
-      return false;
-    }
+    data.Owner = VoxelOwners(ElementRasterizer(mesh), parallel, progress);
   }
-  return !voxelValues ||
-    GroupVoxelValues(data.Owner.data(), voxelValues, mesh.Geometry().Size(), mesh.NumberOfElements(), data.Voxels,
-      error, parallel, SubProgress(progress, 0.6, 1.0));
+  return !data.Owner.empty();
 }
 
 SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutData& data, const std::vector<double>& mean,
@@ -136,7 +130,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
         if (pr.Hard[e])
         {
           std::vector<double>& samples = pr.Hard[e] == 1 ? pr.ObjectSamples : pr.BackgroundSamples;
-          samples.insert(samples.end(), grouped.Value.begin() + grouped.Offset[e], grouped.Value.begin() + grouped.Offset[e + 1]);
+          samples.insert(samples.end(), grouped.Value.get() + grouped.Offset[e], grouped.Value.get() + grouped.Offset[e + 1]);
         }
       }
     }

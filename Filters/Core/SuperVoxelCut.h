@@ -74,10 +74,22 @@ struct SuperVoxelCutData
   bool HasVoxelValues() const { return !this->Voxels.Offset.empty(); }
 };
 
-// Rasterises the mesh, unless `data.Owner` already holds its owners (stage 2's, say), and groups
-// `voxelValues` (optional, one per voxel of the mesh's image) by element. False with a sentence for a bad value, without one when progress asked to abort.
-bool PrepareSuperVoxelCut(const SimplexMesh& mesh, const double* voxelValues, SuperVoxelCutData& data,
-  std::string& error, const ParallelFor& parallel, const ProgressFunction& progress = NoProgress());
+// The element owning each voxel into `data.Owner`, by rasterising the mesh unless it already holds
+// them (stage 2's, say). False when progress asked to abort.
+bool PrepareVoxelOwners(const SimplexMesh& mesh, SuperVoxelCutData& data, const ParallelFor& parallel,
+  const ProgressFunction& progress = NoProgress());
+
+// The owners, and `voxelValues` (optional, one per voxel of the mesh's image, in the image's own type)
+// grouped by element. False with a sentence for a bad value, without one when progress asked to abort.
+template <typename T>
+bool PrepareSuperVoxelCut(const SimplexMesh& mesh, const T* voxelValues, SuperVoxelCutData& data, std::string& error,
+  const ParallelFor& parallel, const ProgressFunction& progress = NoProgress())
+{
+  return PrepareVoxelOwners(mesh, data, parallel, SubProgress(progress, 0.0, voxelValues ? 0.6 : 1.0)) &&
+    (!voxelValues ||
+      GroupVoxelValues(data.Owner.data(), voxelValues, mesh.Geometry().Size(), mesh.NumberOfElements(), data.Voxels,
+        error, parallel, SubProgress(progress, 0.6, 1.0)));
+}
 
 // A voxel's value by index (the image, however it is stored).
 using VoxelValueFunction = std::function<double(std::int64_t)>;

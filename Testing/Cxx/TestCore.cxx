@@ -445,7 +445,7 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   NodeVoxelValues twoGrouped;
   ASSERT_TRUE(GroupVoxelValues(o.data(), v.data(), 6, 3, twoGrouped, error, SerialFor()));
   EXPECT_EQ(twoGrouped.Offset, (std::vector<std::int64_t>{ 0, 1, 2, 6 }));
-  EXPECT_EQ(twoGrouped.Value, (std::vector<double>{ 10.0, 0.0, 0.0, 10.0, 10.0, 10.0 }));
+  EXPECT_EQ(std::vector<double>(twoGrouped.Value.get(), twoGrouped.Value.get() + 6), (std::vector<double>{ 10.0, 0.0, 0.0, 10.0, 10.0, 10.0 }));
   two.NodeVoxels = &twoGrouped;
   const std::vector<double> nan = { 1.0, std::nan(""), 2.0, 3.0, 4.0, 5.0 };
   NodeVoxelValues badGrouped;
@@ -557,7 +557,7 @@ TEST(SuperVoxelCut, ContactAndHardConstraintsOnFourTriangles)
 
   SuperVoxelCutData data;
   std::string prepareError;
-  ASSERT_TRUE(PrepareSuperVoxelCut(mesh, nullptr, data, prepareError, SerialFor()));
+  ASSERT_TRUE(PrepareSuperVoxelCut(mesh, static_cast<const double*>(nullptr), data, prepareError, SerialFor()));
   const std::vector<std::int32_t>& owner = data.Owner;
   const ImageGeometry& g = mesh.Geometry();
   std::vector<std::uint8_t> hard(4, 0);
