@@ -13,6 +13,10 @@ ElementRasterizer::ElementRasterizer(const SimplexMesh& mesh)
   {
     this->TwiceCentre[a] = mesh.Geometry().Dims[a] - 1.0;
   }
+  // Normals of faces between lattice nodes are integers below 2 * 4096^2, plane offsets below
+  // 3 * 2^37, row values below 2^41: all exact in double.
+  const auto& d = mesh.Geometry().Dims;
+  this->ExactBounds = d[0] < 4096 && d[1] < 4096 && d[2] < 4096;
 }
 
 template <typename T>

@@ -50,6 +50,8 @@ private:
 
   const SimplexMesh* M;
   double TwiceCentre[3];
+  // Lattice elements' row bounds are exact (every dimension below 4096 voxels).
+  bool ExactBounds = false;
 };
 
 // Voxel value statistics per element: exact over owned centres; elements owning none take the
@@ -271,12 +273,16 @@ void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
           empty = true;
         }
       }
-      if (empty || xlo > xhi + 1.0)
+      // On the lattice the bounds are exact: the plane's integers stay below 2^53 and a quotient
+      // -b/a that is not an integer lies at least 1/|a| from one, far beyond its rounding, so its
+      // ceiling and floor are those of the exact bound and no widening is needed.
+      const int widen = this->ExactBounds && !offLattice ? 0 : 1;
+      if (empty || xlo > xhi + widen)
       {
         continue;
       }
-      const int s = std::max(i0, static_cast<int>(std::ceil(xlo)) - 1);
-      const int t = std::min(i1, static_cast<int>(std::floor(xhi)) + 1);
+      const int s = std::max(i0, static_cast<int>(std::ceil(xlo)) - widen);
+      const int t = std::min(i1, static_cast<int>(std::floor(xhi)) + widen);
       std::int64_t idx = G.Index(s, j, k);
       for (int i = s; i <= t; ++i, ++idx)
       {
