@@ -8,6 +8,7 @@
 #include <memory>
 #include <numeric>
 #include <stdexcept>
+#include <type_traits>
 
 namespace featuremesh
 {
@@ -155,31 +156,41 @@ bool GroupVoxelValues(const std::int32_t* owner, const T* values, std::int64_t v
   }
   grouped.Offset[nodes] = total;
   // Not zero-filled: every element is written below (a 9 M-voxel volume's 71 MB would be written twice).
-  grouped.Value.reset(new double[total]);
-  double* out = grouped.Value.get();
-  parallel(chunks, 1, [&](std::int64_t c0, std::int64_t c1) {
-    for (std::int64_t c = c0; c < c1; ++c)
-    {
-      std::int64_t* next = cursor.data() + c * nodes;
-      for (std::int64_t v = c * size, e = std::min(voxels, (c + 1) * size); v < e; ++v)
+  auto scatterAndSort = [&](auto* out) {
+    parallel(chunks, 1, [&](std::int64_t c0, std::int64_t c1) {
+      for (std::int64_t c = c0; c < c1; ++c)
       {
-        if (owner[v] >= 0)
+        std::int64_t* next = cursor.data() + c * nodes;
+        for (std::int64_t v = c * size, e = std::min(voxels, (c + 1) * size); v < e; ++v)
         {
-          out[next[owner[v]]++] = static_cast<double>(values[v]);
+          if (owner[v] >= 0)
+          {
+            out[next[owner[v]]++] = static_cast<std::remove_pointer_t<decltype(out)>>(values[v]);
+          }
         }
       }
-    }
-  });
-  if (!progress(0.6))
-  {
-    return false;
-  }
-  return BatchedFor(nodes, 4096, parallel, SubProgress(progress, 0.6, 1.0), [&](std::int64_t b, std::int64_t e) {
-    for (std::int64_t p = b; p < e; ++p)
+    });
+    if (!progress(0.6))
     {
-      std::sort(out + grouped.Offset[p], out + grouped.Offset[p + 1]);
+      return false;
     }
-  });
+    return BatchedFor(nodes, 4096, parallel, SubProgress(progress, 0.6, 1.0), [&](std::int64_t b, std::int64_t e) {
+      for (std::int64_t p = b; p < e; ++p)
+      {
+        std::sort(out + grouped.Offset[p], out + grouped.Offset[p + 1]);
+      }
+    });
+  };
+  constexpr bool single = std::is_same<T, float>::value || (std::is_integral<T>::value && sizeof(T) <= 2);
+  if (single)
+  {
+    grouped.Double.reset();
+    grouped.Single.reset(new float[total]);
+    return scatterAndSort(grouped.Single.get());
+  }
+  grouped.Single.reset();
+  grouped.Double.reset(new double[total]);
+  return scatterAndSort(grouped.Double.get());
 }
 #define FEATUREMESH_GROUP_VOXEL_VALUES(T)                                                                        \
   template bool GroupVoxelValues<T>(const std::int32_t*, const T*, std::int64_t, std::int64_t, NodeVoxelValues&, \
@@ -227,7 +238,7 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
   if ((!pr.Size.empty() && static_cast<std::int64_t>(pr.Size.size()) != n) ||
     static_cast<std::int64_t>(pr.Hard.size()) != n || static_cast<std::int64_t>(pr.B.size()) != m ||
     (!pr.Contact.empty() && static_cast<std::int64_t>(pr.Contact.size()) != m) ||
-    (pr.NodeVoxels && (static_cast<std::int64_t>(pr.NodeVoxels->Offset.size()) != n + 1 || !pr.NodeVoxels->Value)))
+    (pr.NodeVoxels && (static_cast<std::int64_t>(pr.NodeVoxels->Offset.size()) != n + 1 || pr.NodeVoxels->Empty())))
   {
     return "the graph's arrays disagree in length.";
   }
@@ -403,25 +414,27 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   {
     // Each node's values are sorted and bin() is monotone: a node within one bin costs two reads,
     // one spanning several a binary search per bin.
-    const double* all = exact->Value.get();
-    const bool done = BatchedFor(n, 8192, pr.Parallel, SubProgress(progress, 0.2, 0.3), [&](std::int64_t first, std::int64_t last) {
-      for (std::int64_t p = first; p < last; ++p)
-      {
-        double sumObject = 0.0, sumBackground = 0.0;
-        for (const double *x = all + exact->Offset[p], *end = all + exact->Offset[p + 1]; x < end;)
+    const bool done = exact->Visit([&](const auto* all) {
+      return BatchedFor(n, 8192, pr.Parallel, SubProgress(progress, 0.2, 0.3), [&](std::int64_t first, std::int64_t last) {
+        for (std::int64_t p = first; p < last; ++p)
         {
-          const int b = bin(*x);
-          const double* next = b == r.Bins - 1 || bin(end[-1]) == b
-            ? end
-            : std::partition_point(x, end, [&](double y) { return bin(y) <= b; });
-          const double count = static_cast<double>(next - x);
-          sumObject += count * costObject[b];
-          sumBackground += count * costBackground[b];
-          x = next;
+          double sumObject = 0.0, sumBackground = 0.0;
+          using Stored = std::remove_cv_t<std::remove_pointer_t<decltype(all)>>;
+          for (const Stored *x = all + exact->Offset[p], *end = all + exact->Offset[p + 1]; x < end;)
+          {
+            const int b = bin(*x);
+            const Stored* next = b == r.Bins - 1 || bin(end[-1]) == b
+              ? end
+              : std::partition_point(x, end, [&](Stored y) { return bin(y) <= b; });
+            const double count = static_cast<double>(next - x);
+            sumObject += count * costObject[b];
+            sumBackground += count * costBackground[b];
+            x = next;
+          }
+          regionObject[p] = sumObject;
+          regionBackground[p] = sumBackground;
         }
-        regionObject[p] = sumObject;
-        regionBackground[p] = sumBackground;
-      }
+      });
     });
     if (!done)
     {

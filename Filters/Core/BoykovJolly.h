@@ -36,12 +36,22 @@ struct BoykovJollyParameters
 };
 
 // The voxel values of every node, grouped once per graph so that a cut pays per node, not per voxel:
-// node p's values in ascending order are Value[Offset[p] .. Offset[p + 1]); the histogram range
+// node p's values in ascending order are at [Offset[p], Offset[p + 1]); the histogram range
 // comes from Low and High, the 0.5 and 99.5 percentiles of all voxel values.
 struct NodeVoxelValues
 {
   std::vector<std::int64_t> Offset;
-  std::unique_ptr<double[]> Value;
+  // The values, in single precision when that holds each exactly (a float or 8-/16-bit image: half
+  // the memory), else in double; one of the two is set.
+  std::unique_ptr<float[]> Single;
+  std::unique_ptr<double[]> Double;
+  bool Empty() const { return !this->Single && !this->Double; }
+  // f(pointer to the values) with the pointer type they are stored in.
+  template <typename F>
+  auto Visit(F&& f) const
+  {
+    return this->Single ? f(static_cast<const float*>(this->Single.get())) : f(static_cast<const double*>(this->Double.get()));
+  }
   double Low = 0.0, High = 0.0;
 };
 

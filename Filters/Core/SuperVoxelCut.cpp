@@ -130,7 +130,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
         if (pr.Hard[e])
         {
           std::vector<double>& samples = pr.Hard[e] == 1 ? pr.ObjectSamples : pr.BackgroundSamples;
-          samples.insert(samples.end(), grouped.Value.get() + grouped.Offset[e], grouped.Value.get() + grouped.Offset[e + 1]);
+          grouped.Visit([&](const auto* all) { samples.insert(samples.end(), all + grouped.Offset[e], all + grouped.Offset[e + 1]); });
         }
       }
     }

@@ -445,7 +445,7 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   NodeVoxelValues twoGrouped;
   ASSERT_TRUE(GroupVoxelValues(o.data(), v.data(), 6, 3, twoGrouped, error, SerialFor()));
   EXPECT_EQ(twoGrouped.Offset, (std::vector<std::int64_t>{ 0, 1, 2, 6 }));
-  EXPECT_EQ(std::vector<double>(twoGrouped.Value.get(), twoGrouped.Value.get() + 6), (std::vector<double>{ 10.0, 0.0, 0.0, 10.0, 10.0, 10.0 }));
+  EXPECT_EQ(std::vector<double>(twoGrouped.Double.get(), twoGrouped.Double.get() + 6), (std::vector<double>{ 10.0, 0.0, 0.0, 10.0, 10.0, 10.0 }));
   two.NodeVoxels = &twoGrouped;
   const std::vector<double> nan = { 1.0, std::nan(""), 2.0, 3.0, 4.0, 5.0 };
   NodeVoxelValues badGrouped;
