@@ -1,0 +1,125 @@
+"""How the pipeline scales with the voxel count (pvpython): BraTS-0005 at 1x, resampled to 2x the voxels
+and to 512^3, each run in a fresh process so that its peak memory is its own.
+
+usage: pvpython scripts/benchmark_scale.py [--case brain-tumour-brats-0005] [--out out/benchmark_scale]
+Each size runs stages 1 -> 2 -> 3 -> 4 at their defaults on the case's seeds (world points, so they
+hold on a resampled image) and reports each stage's seconds, the total, seconds per million voxels,
+the elements and the process's peak resident memory. The resampled images (linear interpolation,
+same world box) are written to a temporary folder first. Writes OUT.md and OUT.csv.
+"""
+import argparse
+import csv
+import json
+import os
+import platform
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+
+SIZES = (("1x", None), ("2x", 2.0 ** (1.0 / 3.0)), ("512^3", 512))
+
+
+def make_image(source, target, factor):
+    """Resamples `source` (.mha) by `factor` per axis, or to factor^3 voxels when it is an int."""
+    from vtkmodules.vtkIOImage import vtkMetaImageReader, vtkMetaImageWriter
+    from vtkmodules.vtkImagingCore import vtkImageResample
+    reader = vtkMetaImageReader()
+    reader.SetFileName(source)
+    reader.Update()
+    dims = reader.GetOutput().GetDimensions()
+    resample = vtkImageResample()
+    resample.SetInputConnection(reader.GetOutputPort())
+    resample.SetInterpolationModeToLinear()
+    for axis in range(3):
+        # The magnification maps the first to the last voxel centre: (dims - 1) * f + 1 voxels.
+        f = (factor - 1) / (dims[axis] - 1) if isinstance(factor, int) else factor
+        resample.SetAxisMagnificationFactor(axis, f)
+    writer = vtkMetaImageWriter()
+    writer.SetInputConnection(resample.GetOutputPort())
+    writer.SetFileName(target)
+    writer.SetCompression(False)
+    writer.Write()
+
+
+def child(folder, image):
+    import featuremesh as fm
+    fm.load_plugin()
+    case = fm.Case(folder, image=image)
+    voxels = fm.fetch(case.image).GetNumberOfPoints()
+    nodes = case.feature_nodes()
+    mesh = case.mesh(nodes)
+    smooth = case.smoothing(mesh)
+    cut = case.super_voxel_cut(smooth)
+    row = {"voxels": voxels}
+    for key, proxy in (("nodes_s", nodes), ("mesh_s", mesh), ("smoothing_s", smooth), ("cut_s", cut)):
+        t = time.perf_counter()
+        proxy.UpdatePipeline()
+        row[key] = time.perf_counter() - t
+    row["elements"] = fm.fetch(cut, 0).GetNumberOfCells()
+    row["peak_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0 ** 2
+    print("RESULT " + json.dumps(row))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--case", default="brain-tumour-brats-0005")
+    ap.add_argument("--out", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "out", "benchmark_scale"))
+    ap.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
+    ap.add_argument("--make", nargs=3, help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.child:
+        return child(*args.child)
+    if args.make:
+        return make_image(args.make[0], args.make[1], int(args.make[2]) if args.make[2].isdigit() else float(args.make[2]))
+    import featuremesh as fm
+    folder = fm.case_dir(args.case)
+    if folder is None:
+        raise SystemExit("case %s not found (bundled Data/ or ../shared/data/cases)" % args.case)
+    pvpython = shutil.which("pvpython") or sys.executable
+    work = tempfile.mkdtemp()
+    rows = []
+    try:
+        for name, factor in SIZES:
+            image = os.path.join(folder, "image.mha")
+            if factor is not None:
+                image = os.path.join(work, "image_%s.mha" % name.replace("^", ""))
+                subprocess.run([pvpython, __file__, "--make", os.path.join(folder, "image.mha"), image, str(factor)], check=True)
+            run = subprocess.run([pvpython, __file__, "--child", folder, image], capture_output=True, text=True)
+            lines = [l for l in run.stdout.splitlines() if l.startswith("RESULT ")]
+            if run.returncode != 0 or not lines:
+                print("%s: failed (%s)" % (name, run.stderr[-800:]))
+                continue
+            row = {"size": name, **json.loads(lines[-1][7:])}
+            row["total_s"] = sum(row[k] for k in ("nodes_s", "mesh_s", "smoothing_s", "cut_s"))
+            row["us_per_voxel"] = 1e6 * row["total_s"] / row["voxels"]
+            row["bytes_per_voxel"] = row["peak_gb"] * 1024.0 ** 3 / row["voxels"]
+            rows.append(row)
+            print(" | ".join("%s %s" % (k, ("%.3f" % v) if isinstance(v, float) else v) for k, v in row.items()), flush=True)
+            if factor is not None:
+                os.remove(image)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    keys = ["size", "voxels", "elements", "nodes_s", "mesh_s", "smoothing_s", "cut_s", "total_s", "us_per_voxel",
+            "peak_gb", "bytes_per_voxel"]
+    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
+    with open(args.out + ".csv", "w", newline="") as f:
+        w = csv.DictWriter(f, keys)
+        w.writeheader()
+        w.writerows(rows)
+    machine = "%s, %d cores, %s" % (platform.machine(), os.cpu_count(), platform.platform())
+    lines = ["Machine: %s; %s, one run per size, each in its own process." % (machine, args.case), "",
+             "| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
+    for r in rows:
+        lines.append("| " + " | ".join(("%.3f" % r[k]) if isinstance(r[k], float) else str(r[k]) for k in keys) + " |")
+    with open(args.out + ".md", "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
