@@ -1,11 +1,11 @@
 """How the pipeline scales with the voxel count (pvpython): BraTS-0005 at 1x, resampled to 2x the voxels
 and to 512^3, each run in a fresh process so that its peak memory is its own.
 
-usage: pvpython scripts/benchmark_scale.py [--case brain-tumour-brats-0005] [--out out/benchmark_scale]
+usage: pvpython scripts/benchmark_scale.py [--case brain-tumour-brats-0005] [--sizes 1x,2x,512^3] [--out out/benchmark_scale]
 Each size runs stages 1 -> 2 -> 3 -> 4 at their defaults on the case's seeds (world points, so they
 hold on a resampled image) and reports each stage's seconds, the total, seconds per million voxels,
 the elements and the process's peak resident memory. The resampled images (linear interpolation,
-same world box) are written to a temporary folder first. Writes OUT.md and OUT.csv.
+the same first and last voxel centres) are written to a temporary folder first. Writes OUT.md and OUT.csv.
 """
 import argparse
 import csv
@@ -25,22 +25,25 @@ SIZES = (("1x", None), ("2x", 2.0 ** (1.0 / 3.0)), ("512^3", 512))
 
 
 def make_image(source, target, factor):
-    """Resamples `source` (.mha) by `factor` per axis, or to factor^3 voxels when it is an int."""
+    """Resamples `source` (.mha) over the same world box (first and last voxel centres kept, so seeds
+    on its border stay inside): `factor` times the voxels per axis, or `factor` voxels per axis when
+    it is an int."""
     from vtkmodules.vtkIOImage import vtkMetaImageReader, vtkMetaImageWriter
-    from vtkmodules.vtkImagingCore import vtkImageResample
+    from vtkmodules.vtkImagingCore import vtkImageReslice
     reader = vtkMetaImageReader()
     reader.SetFileName(source)
     reader.Update()
-    dims = reader.GetOutput().GetDimensions()
-    resample = vtkImageResample()
-    resample.SetInputConnection(reader.GetOutputPort())
-    resample.SetInterpolationModeToLinear()
-    for axis in range(3):
-        # The magnification maps the first to the last voxel centre: (dims - 1) * f + 1 voxels.
-        f = (factor - 1) / (dims[axis] - 1) if isinstance(factor, int) else factor
-        resample.SetAxisMagnificationFactor(axis, f)
+    image = reader.GetOutput()
+    dims, spacing = image.GetDimensions(), image.GetSpacing()
+    out = [factor if isinstance(factor, int) else int(round((d - 1) * factor)) + 1 for d in dims]
+    reslice = vtkImageReslice()
+    reslice.SetInputConnection(reader.GetOutputPort())
+    reslice.SetInterpolationModeToLinear()
+    reslice.SetOutputOrigin(image.GetOrigin())
+    reslice.SetOutputSpacing([spacing[a] * (dims[a] - 1) / (out[a] - 1) for a in range(3)])
+    reslice.SetOutputExtent(0, out[0] - 1, 0, out[1] - 1, 0, out[2] - 1)
     writer = vtkMetaImageWriter()
-    writer.SetInputConnection(resample.GetOutputPort())
+    writer.SetInputConnection(reslice.GetOutputPort())
     writer.SetFileName(target)
     writer.SetCompression(False)
     writer.Write()
@@ -69,6 +72,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--case", default="brain-tumour-brats-0005")
     ap.add_argument("--out", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "out", "benchmark_scale"))
+    ap.add_argument("--sizes", default=",".join(name for name, _ in SIZES))
     ap.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
     ap.add_argument("--make", nargs=3, help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -84,7 +88,7 @@ def main():
     work = tempfile.mkdtemp()
     rows = []
     try:
-        for name, factor in SIZES:
+        for name, factor in [(n, f) for n, f in SIZES if n in args.sizes.split(",")]:
             image = os.path.join(folder, "image.mha")
             if factor is not None:
                 image = os.path.join(work, "image_%s.mha" % name.replace("^", ""))
