@@ -8,7 +8,6 @@ the elements and the process's peak resident memory. The resampled images (linea
 the same first and last voxel centres) are written to a temporary folder first. Writes OUT.md and OUT.csv.
 """
 import argparse
-import csv
 import json
 import os
 import platform
@@ -20,6 +19,7 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+from featuremesh.report import write_table  # noqa: E402
 
 SIZES = (("1x", None), ("2x", 2.0 ** (1.0 / 3.0)), ("512^3", 512))
 
@@ -110,20 +110,8 @@ def main():
         shutil.rmtree(work, ignore_errors=True)
     keys = ["size", "voxels", "elements", "nodes_s", "mesh_s", "smoothing_s", "cut_s", "total_s", "us_per_voxel",
             "peak_gb", "bytes_per_voxel"]
-    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-    with open(args.out + ".csv", "w", newline="") as f:
-        w = csv.DictWriter(f, keys)
-        w.writeheader()
-        w.writerows(rows)
     machine = "%s, %d cores, %s" % (platform.machine(), os.cpu_count(), platform.platform())
-    lines = ["Machine: %s; %s, one run per size, each in its own process." % (machine, args.case), "",
-             "| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
-    for r in rows:
-        lines.append("| " + " | ".join(("%.3f" % r[k]) if isinstance(r[k], float) else str(r[k]) for k in keys) + " |")
-    with open(args.out + ".md", "w") as f:
-        f.write("\n".join(lines) + "\n")
-    print("\n".join(lines))
-
+    write_table(args.out, rows, keys, "Machine: %s; %s, one run per size, each in its own process." % (machine, args.case))
 
 if __name__ == "__main__":
     main()

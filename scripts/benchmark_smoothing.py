@@ -10,7 +10,6 @@ majority reference label), elements owning no voxel, and the smoothing filter's 
 --runs). Writes OUT.md and OUT.csv.
 """
 import argparse
-import csv
 import os
 import statistics
 import sys
@@ -22,6 +21,7 @@ from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
 import featuremesh as fm  # noqa: E402
+from featuremesh.report import write_table  # noqa: E402
 from featuremesh import metrics  # noqa: E402
 
 
@@ -92,19 +92,8 @@ def main():
         rows.append(row)
         print(" | ".join("%s %s" % (k, ("%.3f" % v) if isinstance(v, float) else v) for k, v in row.items()), flush=True)
     keys = list(rows[0].keys()) if rows else []
-    os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
-    with open(args.out + ".csv", "w", newline="") as f:
-        w = csv.DictWriter(f, keys)
-        w.writeheader()
-        w.writerows(rows)
-    lines = ["Image Mesh Smoothing %s against the Delaunay mesh; angles in degrees (3D: dihedral)." % (
-        args.smoothing or "at its defaults"), "", "| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
-    for r in rows:
-        lines.append("| " + " | ".join(("%.3f" % r[k]) if isinstance(r[k], float) else str(r[k]) for k in keys) + " |")
-    with open(args.out + ".md", "w") as f:
-        f.write("\n".join(lines) + "\n")
-    print("\n".join(lines))
-
+    write_table(args.out, rows, keys, "Image Mesh Smoothing %s against the Delaunay mesh; angles in degrees (3D: dihedral)." % (
+        args.smoothing or "at its defaults"))
 
 if __name__ == "__main__":
     main()
