@@ -603,9 +603,13 @@ bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, std::ve
   }
   const std::int32_t* p = array->GetPointer(0);
   const vtkIdType cells = mesh->GetNumberOfCells();
+  // Ids must name cells: a map edited by hand is not trusted (and not left in `owner`).
+  if (!std::all_of(p, p + voxels, [cells](std::int32_t e) { return e >= -1 && e < cells; }))
+  {
+    return false;
+  }
   owner.assign(p, p + voxels);
-  // Ids must name cells: a map edited by hand is not trusted.
-  return std::all_of(owner.begin(), owner.end(), [cells](std::int32_t e) { return e >= -1 && e < cells; });
+  return true;
 }
 
 bool ToDouble(vtkDataArray* array, std::vector<double>& values, std::string& error)

@@ -135,6 +135,18 @@ a, b = (ft.array(ft.fetch(c, 2), "ElementId") for c in ids)
 ft.check(ft.np.array_equal(a, b) and ft.np.array_equal(ft.v2n(owner_map), a),
          "the attached owner map equals the cut's own rasterisation (%d voxels)" % a.size)
 ft.check(ft.fetch(cut).GetFieldData().GetArray("VoxelOwner") is None, "the labelled mesh does not carry the owner map")
+# A map whose ids name no cell (edited by hand, digest intact) is not trusted: the cut rasterises.
+tamper = ft.ProgrammableFilter(Input=cut.Mesh, OutputDataSetType="vtkUnstructuredGrid", Script="""
+from vtkmodules.vtkCommonCore import vtkIntArray
+out = self.GetOutput()
+out.ShallowCopy(self.GetInput())
+bad = vtkIntArray()
+bad.DeepCopy(out.GetFieldData().GetArray('VoxelOwner'))
+bad.SetValue(0, 10**9)
+out.GetFieldData().AddArray(bad)""")
+tampered = ft.SuperVoxelCut(Mesh=tamper, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, SuperVoxelIds=1)
+ft.check(ft.np.array_equal(ft.array(ft.fetch(tampered, 2), "ElementId"), a),
+         "a VoxelOwner map naming a missing cell is ignored: the cut's own rasterisation is used")
 
 # A chain of seed edits reuses the last max-flow (Kohli-Torr): after each, labels and flow equal a
 # fresh cut's. The edits move a seed by a voxel and back, onto another element, add and drop seeds.
