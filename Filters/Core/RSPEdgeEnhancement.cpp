@@ -492,14 +492,26 @@ RSPResult OnCoarserGrid(const float* image, const ImageGeometry& g, const std::v
   out.EdgeMap.resize(static_cast<std::size_t>(n));
   out.ObjectDistance.resize(static_cast<std::size_t>(n));
   out.BackgroundDistance.resize(static_cast<std::size_t>(n));
-  parallel(n, 1 << 16, [&](std::int64_t b, std::int64_t e) {
-    for (std::int64_t v = b; v < e; ++v)
+  // Row by row without divisions.
+  const float scale = static_cast<float>(f);
+  parallel(static_cast<std::int64_t>(g.Dims[1]) * g.Dims[2], 64, [&](std::int64_t r0, std::int64_t r1) {
+    for (std::int64_t row = r0; row < r1; ++row)
     {
-      const std::int64_t k = block(v);
-      out.EdgeConfidence[v] = r.EdgeConfidence[k];
-      out.EdgeMap[v] = r.EdgeMap[k];
-      out.ObjectDistance[v] = r.ObjectDistance[k] * static_cast<float>(f);
-      out.BackgroundDistance[v] = r.BackgroundDistance[k] * static_cast<float>(f);
+      const int j = static_cast<int>(row % g.Dims[1]), k = static_cast<int>(row / g.Dims[1]);
+      const std::int64_t v0 = g.Index(0, j, k), k0 = c.Index(0, j / f, dim == 3 ? k / f : 0);
+      for (int i = 0, ci = 0, left = f; i < g.Dims[0]; ++i)
+      {
+        const std::int64_t v = v0 + i, kc = k0 + ci;
+        out.EdgeConfidence[v] = r.EdgeConfidence[kc];
+        out.EdgeMap[v] = r.EdgeMap[kc];
+        out.ObjectDistance[v] = r.ObjectDistance[kc] * scale;
+        out.BackgroundDistance[v] = r.BackgroundDistance[kc] * scale;
+        if (--left == 0)
+        {
+          ++ci;
+          left = f;
+        }
+      }
     }
   });
   // Samples at their block's centre voxel (inside the image).
@@ -636,6 +648,11 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
     return out;
   }
   out.StepSeconds.emplace_back("sampling", SecondsSince(t0));
+  if (!progress(0.27))
+  {
+    out.Aborted = true;
+    return out;
+  }
 
   // 4. All source-sink shortest paths, in the box both maps reach, grown by the margin.
   t0 = Clock::now();
@@ -663,6 +680,11 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
   }
   box.Frame.Dims = box.Dims;
   out.PathVoxels = box.Size();
+  if (!progress(0.28))
+  {
+    out.Aborted = true;
+    return out;
+  }
   if (box.Size() >= std::numeric_limits<std::uint32_t>::max())
   {
     out.Error = "the region the paths run in is too large (more than 4 G voxels).";
@@ -704,6 +726,11 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
       }
     });
     maxWeight = *std::max_element(rowMax.begin(), rowMax.end());
+  }
+  if (!progress(0.3))
+  {
+    out.Aborted = true;
+    return out;
   }
   std::vector<std::uint32_t> sinks;
   std::vector<std::uint8_t> isSink(static_cast<std::size_t>(box.Size()), 0);
