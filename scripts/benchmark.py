@@ -32,7 +32,6 @@ connectivity rule, on the same meshes. Writes OUT.md and OUT.csv (and OUT_lambda
 import argparse
 import csv
 import os
-import platform
 import statistics
 import subprocess
 import sys
@@ -46,7 +45,7 @@ from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
 import featuremesh as fm  # noqa: E402
-from featuremesh import metrics  # noqa: E402
+from featuremesh import metrics, report  # noqa: E402
 
 CONNECTIVITY = {0: "off", 1: "fill", 2: "seeded"}
 
@@ -206,7 +205,11 @@ def main():
     ap.add_argument("--no-slic", action="store_true", help="skip the super-pixel table")
     ap.add_argument("--no-peers", action="store_true", help="skip the random walker and watershed")
     ap.add_argument("--lambdas", default="", help="comma-separated lambdas for the lambda table")
+    ap.add_argument("--hugepages", action="store_true",
+                    help="run with malloc using transparent huge pages (both cuts and every library alike)")
     args = ap.parse_args()
+    if args.hugepages:
+        report.use_huge_pages(sys.argv)
     args.lambdas = [float(v) for v in args.lambdas.split(",") if v]
     fm.load_plugin()
     selection = [c for c in args.cases.split(",") if c]
@@ -229,7 +232,7 @@ def main():
         w = csv.DictWriter(f, keys)
         w.writeheader()
         w.writerows(rows)
-    machine = "%s, %d cores, %s" % (platform.machine(), os.cpu_count(), platform.platform())
+    machine = report.machine()
     seg = [k for k in keys if k in ("case", "components") or k.startswith("dice_") or k.endswith(("walker_s", "shed_s", "_scale"))]
     speed = [k for k in keys if k in ("case", "voxels", "elements", "nodes_s", "mesh_s", "smoothing_s", "cut_s", "total_s",
                                       "voxel_cut_s", "speedup", "mesh3_s", "classic_s", "classic_speedup", "recut_s",

@@ -10,7 +10,6 @@ the same first and last voxel centres) are written to a temporary folder first. 
 import argparse
 import json
 import os
-import platform
 import resource
 import shutil
 import subprocess
@@ -19,6 +18,7 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+from featuremesh import report  # noqa: E402
 from featuremesh.report import write_table  # noqa: E402
 
 SIZES = (("1x", None), ("2x", 2.0 ** (1.0 / 3.0)), ("512^3", 512))
@@ -75,7 +75,10 @@ def main():
     ap.add_argument("--sizes", default=",".join(name for name, _ in SIZES))
     ap.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
     ap.add_argument("--make", nargs=3, help=argparse.SUPPRESS)
+    ap.add_argument("--hugepages", action="store_true", help="run with malloc using transparent huge pages")
     args = ap.parse_args()
+    if args.hugepages:
+        report.use_huge_pages(sys.argv)
     if args.child:
         return child(*args.child)
     if args.make:
@@ -110,7 +113,7 @@ def main():
         shutil.rmtree(work, ignore_errors=True)
     keys = ["size", "voxels", "elements", "nodes_s", "mesh_s", "smoothing_s", "cut_s", "total_s", "us_per_voxel",
             "peak_gb", "bytes_per_voxel"]
-    machine = "%s, %d cores, %s" % (platform.machine(), os.cpu_count(), platform.platform())
+    machine = report.machine()
     write_table(args.out, rows, keys, "Machine: %s; %s, one run per size, each in its own process." % (machine, args.case))
 
 if __name__ == "__main__":

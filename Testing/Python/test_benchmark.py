@@ -4,6 +4,7 @@ bounds every labelling of its elements, the super-voxel cut's included; scores l
 SLIC runs bracket K."""
 import csv
 import os
+import re
 import shutil
 import subprocess
 import tempfile
@@ -18,6 +19,8 @@ print(run.stdout[-3000:])
 ft.check(run.returncode == 0, "benchmark.py exits 0 (stderr: %s)" % run.stderr[-500:])
 ft.check("## Speed" in run.stdout and "## Mesh quality" in run.stdout and "## The mesh as super-pixels" in run.stdout and "dice_random_walker" in run.stdout and "dice_watershed" in run.stdout,
          "the printed tables hold the super-pixel table and the peer columns")
+ft.check(re.search(r"fresh memory [0-9]+ ms per 100 MB \(default malloc\)", run.stdout) is not None,
+         "the machine line gives the cost of fresh memory under the default malloc")
 rows = list(csv.DictReader(open(out + ".csv"))) if os.path.isfile(out + ".csv") else []
 ft.check(sorted(r["case"] for r in rows) == ["liver-ct-totalseg", "nuclei-dsb2018"], "both bundled cases in the CSV")
 for r in rows:

@@ -1,6 +1,7 @@
 """The scale benchmark on the bundled liver at 1x and 2x the voxels: both sizes run in their own
 processes, the resampled image has about twice the voxels, and the table's figures follow from the
-times and the peak memory."""
+times and the peak memory; --hugepages re-runs it under malloc with transparent huge pages and
+says so."""
 import csv
 import os
 import shutil
@@ -11,10 +12,11 @@ import fmtest as ft
 
 out = os.path.join(tempfile.mkdtemp(), "scale")
 script = os.path.join(ft.fm.ROOT, "scripts", "benchmark_scale.py")
-run = subprocess.run([shutil.which("pvpython"), script, "--case", "liver-ct-totalseg", "--sizes", "1x,2x", "--out", out],
+run = subprocess.run([shutil.which("pvpython"), script, "--case", "liver-ct-totalseg", "--sizes", "1x,2x", "--hugepages", "--out", out],
                      capture_output=True, text=True)
 print(run.stdout[-2000:])
 ft.check(run.returncode == 0, "benchmark_scale.py exits 0 (stderr: %s)" % run.stderr[-500:])
+ft.check("(malloc with transparent huge pages)" in run.stdout, "the machine line says malloc asks for huge pages")
 rows = list(csv.DictReader(open(out + ".csv"))) if os.path.isfile(out + ".csv") else []
 ft.check([r["size"] for r in rows] == ["1x", "2x"], "both sizes in the CSV")
 if len(rows) == 2:
