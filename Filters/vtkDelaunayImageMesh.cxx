@@ -91,8 +91,9 @@ int vtkDelaunayImageMesh::RequestData(
                                             << " mesh needs at least " << (is2D ? 3 : 4) << ".");
       return 0;
     }
-    std::vector<double> values;
-    const bool valuesOk = ChosenValues(image, this->GetInputArrayInformation(0), values, error, warning);
+    // The image is read in its own type (checked as ToDouble would, without the copy).
+    vtkDataArray* values = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
+    const bool valuesOk = values && CheckDouble(values, error);
     if (!warning.empty())
     {
       vtkWarningMacro("Delaunay Image Mesh: " << warning);
@@ -218,8 +219,8 @@ int vtkDelaunayImageMesh::RequestData(
     const ParallelFor parallel = SMPParallelFor();
     const SimplexMesh mesh(geometry, std::move(index), std::move(delaunay.Cells), delaunay.VerticesPerCell);
     const vtkSmartPointer<vtkIntArray> owner = NewVoxelOwnerArray(geometry.Size());
-    const ElementStatistics stats = ComputeElementStatistics(
-      ElementRasterizer(mesh), values.data(), parallel, AlgorithmProgress(this, 0.5, 0.9), owner->GetPointer(0));
+    const ElementStatistics stats =
+      ImageElementStatistics(ElementRasterizer(mesh), values, parallel, AlgorithmProgress(this, 0.5, 0.9), owner->GetPointer(0));
     if (stats.Aborted)
     {
       return 1;

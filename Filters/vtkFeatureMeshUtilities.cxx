@@ -622,6 +622,20 @@ bool CheckDouble(vtkDataArray* array, std::string& error)
   return ToValues<double>(array, nullptr, error);
 }
 
+ElementStatistics ImageElementStatistics(const ElementRasterizer& raster, vtkDataArray* values,
+  const ParallelFor& parallel, const ProgressFunction& progress, std::int32_t* owner)
+{
+  switch (values->GetDataType())
+  {
+    vtkTemplateMacro(
+      return ComputeElementStatistics(raster, static_cast<const VTK_TT*>(values->GetVoidPointer(0)), parallel, progress, owner));
+  }
+  // CheckDouble rejected every other type.
+  ElementStatistics none;
+  none.Aborted = true;
+  return none;
+}
+
 vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::string& error, std::string& warning)
 {
   const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME()) ? arrayInfo->Get(vtkDataObject::FIELD_NAME()) : nullptr;

@@ -159,6 +159,11 @@ bool ToDouble(vtkDataArray* array, std::vector<double>& values, std::string& err
 // What ToDouble checks, without the copy (a stage that reads the array in its own type).
 bool CheckDouble(vtkDataArray* array, std::string& error);
 
+// ComputeElementStatistics on the array's own values (no double copy: 71 MB of fresh pages on BraTS);
+// `values` passed CheckDouble.
+ElementStatistics ImageElementStatistics(const ElementRasterizer& raster, vtkDataArray* values,
+  const ParallelFor& parallel, const ProgressFunction& progress, std::int32_t* owner);
+
 // Copies a one-component array to float, rejecting NaN/Inf (error names how many).
 bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error);
 

@@ -118,15 +118,15 @@ int vtkImageMeshSmoothing::RequestData(
       return fail(error);
     }
     this->UpdateProgress(0.02);
-    // Doubles for the exact statistics; floats for the density (the array itself when it is float).
+    // The exact statistics read the array in its own type; the density reads floats (the array
+    // itself when it is float).
     vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
     if (!warning.empty())
     {
       vtkWarningMacro("Image Mesh Smoothing: " << warning);
     }
-    std::vector<double> values;
     std::vector<float> floatStorage;
-    const float* floats = array && ToDouble(array, values, error) ? FloatValues(array, floatStorage, error) : nullptr;
+    const float* floats = array && CheckDouble(array, error) ? FloatValues(array, floatStorage, error) : nullptr;
     if (!floats)
     {
       return fail(error);
@@ -161,8 +161,8 @@ int vtkImageMeshSmoothing::RequestData(
 
     t0 = Clock::now();
     const vtkSmartPointer<vtkIntArray> owner = NewVoxelOwnerArray(geometry.Size());
-    const ElementStatistics stats = ComputeElementStatistics(
-      ElementRasterizer(result.Mesh), values.data(), parallel, AlgorithmProgress(this, 0.6, 0.95), owner->GetPointer(0));
+    const ElementStatistics stats = ImageElementStatistics(
+      ElementRasterizer(result.Mesh), array, parallel, AlgorithmProgress(this, 0.6, 0.95), owner->GetPointer(0));
     if (stats.Aborted)
     {
       return 1;

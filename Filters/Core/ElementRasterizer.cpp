@@ -50,10 +50,9 @@ double InterpolateAt(const T* values, const ImageGeometry& g, const double index
   }
   return result;
 }
-template double InterpolateAt<double>(const double*, const ImageGeometry&, const double[3]);
-template double InterpolateAt<float>(const float*, const ImageGeometry&, const double[3]);
 
-ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, const double* values,
+template <typename T>
+ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, const T* values,
   const ParallelFor& parallel, const ProgressFunction& progress, std::int32_t* owner)
 {
   const SimplexMesh& mesh = raster.Mesh();
@@ -83,10 +82,10 @@ ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, cons
         }
         if (count == 0)
         {
-          shift = values[v];
+          shift = static_cast<double>(values[v]);
         }
         ++count;
-        const double d = values[v] - shift;
+        const double d = static_cast<double>(values[v]) - shift;
         sum += d;
         ss += d * d;
       });
@@ -114,6 +113,26 @@ ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, cons
   });
   return s;
 }
+
+// Every type an image's values come in (vtkTemplateMacro's list).
+#define FEATUREMESH_INSTANTIATE(T)                                                                   \
+  template double InterpolateAt<T>(const T*, const ImageGeometry&, const double[3]);                \
+  template ElementStatistics ComputeElementStatistics<T>(                                            \
+    const ElementRasterizer&, const T*, const ParallelFor&, const ProgressFunction&, std::int32_t*);
+FEATUREMESH_INSTANTIATE(double)
+FEATUREMESH_INSTANTIATE(float)
+FEATUREMESH_INSTANTIATE(long long)
+FEATUREMESH_INSTANTIATE(unsigned long long)
+FEATUREMESH_INSTANTIATE(long)
+FEATUREMESH_INSTANTIATE(unsigned long)
+FEATUREMESH_INSTANTIATE(int)
+FEATUREMESH_INSTANTIATE(unsigned int)
+FEATUREMESH_INSTANTIATE(short)
+FEATUREMESH_INSTANTIATE(unsigned short)
+FEATUREMESH_INSTANTIATE(char)
+FEATUREMESH_INSTANTIATE(signed char)
+FEATUREMESH_INSTANTIATE(unsigned char)
+#undef FEATUREMESH_INSTANTIATE
 
 std::vector<std::int32_t> VoxelOwners(const ElementRasterizer& raster, const ParallelFor& parallel,
   const ProgressFunction& progress)

@@ -64,9 +64,10 @@ struct ElementStatistics
   std::vector<double> StdDev;
   std::vector<std::uint8_t> Interpolated;
 };
-// `values` has one value per voxel of the mesh's image. `owner` (optional, one per voxel) receives
-// what VoxelOwners gives, from the same pass.
-ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, const double* values,
+// `values` has one value per voxel of the mesh's image, in the image's own type (every arithmetic type;
+// sums in double). `owner` (optional, one per voxel) receives what VoxelOwners gives, from the same pass.
+template <typename T>
+ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, const T* values,
   const ParallelFor& parallel, const ProgressFunction& progress = NoProgress(), std::int32_t* owner = nullptr);
 
 // Owner element of every voxel (-1 where none, which only happens when the mesh does not tile the box).
@@ -83,7 +84,7 @@ void ElementQuality(const SimplexMesh& mesh, std::vector<double>& minAngle, std:
 // vertices v[0..vpc) (any orientation; 0 for a flat one).
 double SimplexMinAngle(const std::array<double, 3>* const* v, int verticesPerCell);
 
-// Trilinear (bilinear in 2D) interpolation of voxel values at a continuous index (T double or float).
+// Trilinear (bilinear in 2D) interpolation of voxel values at a continuous index (T any arithmetic type).
 template <typename T>
 double InterpolateAt(const T* values, const ImageGeometry& grid, const double index[3]);
 
