@@ -44,6 +44,10 @@ private:
     double Plane[4];
     const std::array<double, 3>* Vertex[3];
     double Sign;
+    // Off the lattice: lambda's rounding per unit of coordinate, far above it (1e-9 of the size of
+    // the products forming the normal: a near-degenerate face has a normal far smaller than its
+    // rounding error, so |n| would not do).
+    double Band;
   };
   bool Owns(const Face* face, int faces, bool offLattice, double x, double y, double z) const;
   bool ExactTie(const Face& face, int faces) const;
@@ -96,7 +100,7 @@ inline bool ElementRasterizer::Owns(const Face* face, int faces, bool offLattice
   {
     const double* n = face[f].Plane;
     double lambda = n[0] * x + n[1] * y + n[2] * z + n[3];
-    if (offLattice && std::fabs(lambda) < 1e-9 * (std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2])) * (1.0 + std::fabs(x) + std::fabs(y) + std::fabs(z)))
+    if (offLattice && std::fabs(lambda) < face[f].Band * (1.0 + std::fabs(x) + std::fabs(y) + std::fabs(z)))
     {
       // Off the lattice the plane is rounded: a centre on or a hair from the face is decided by
       // the exact sign (on the lattice every test above is exact integer arithmetic).
@@ -207,13 +211,14 @@ void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
     std::sort(ids, ids + faces - 1);
     const auto& p = P[ids[0]];
     const auto& q = P[ids[1]];
-    double n[3], d;
+    double n[3], d, size;
     if (faces == 3)
     {
       n[0] = -(q[1] - p[1]);
       n[1] = q[0] - p[0];
       n[2] = 0.0;
       d = -(n[0] * p[0] + n[1] * p[1]);
+      size = std::fabs(n[0]) + std::fabs(n[1]);
     }
     else
     {
@@ -224,6 +229,8 @@ void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
       n[1] = u[2] * w[0] - u[0] * w[2];
       n[2] = u[0] * w[1] - u[1] * w[0];
       d = -(n[0] * p[0] + n[1] * p[1] + n[2] * p[2]);
+      size = std::fabs(u[1] * w[2]) + std::fabs(u[2] * w[1]) + std::fabs(u[2] * w[0]) + std::fabs(u[0] * w[2]) +
+        std::fabs(u[0] * w[1]) + std::fabs(u[1] * w[0]);
     }
     // Positive on the side of the opposite vertex (exactly, off the lattice: slivers are flat).
     const auto& o = P[cell[f]];
@@ -235,6 +242,7 @@ void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
     face[f].Plane[2] = sign * n[2];
     face[f].Plane[3] = sign * d;
     face[f].Sign = sign;
+    face[f].Band = 1e-9 * size;
     for (int v = 0; v < faces - 1; ++v)
     {
       face[f].Vertex[v] = &P[ids[v]];
@@ -258,9 +266,7 @@ void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
         const double* n = face[f].Plane;
         const double a = n[0];
         const double b = n[1] * j + n[2] * k + n[3];
-        const double slack = offLattice
-          ? 1e-9 * (std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2])) * (1.0 + G.Dims[0] + j + k)
-          : 0.0;
+        const double slack = offLattice ? face[f].Band * (1.0 + G.Dims[0] + j + k) : 0.0;
         if (a > 0)
         {
           xlo = std::max(xlo, (-b - slack) / a);
@@ -276,8 +282,11 @@ void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
       }
       // On the lattice the bounds are exact: the plane's integers stay below 2^53 and a quotient
       // -b/a that is not an integer lies at least 1/|a| from one, far beyond its rounding, so its
-      // ceiling and floor are those of the exact bound and no widening is needed.
-      const int widen = this->ExactBounds && !offLattice ? 0 : 1;
+      // ceiling and floor are those of the exact bound and no widening is needed. Off the lattice
+      // the slack moves each bound out by at least 1e-9 (1 + Dims[0]) voxels (Band >= 1e-9 |a|),
+      // beyond the quotient's rounding (~1e-16 of the coordinates), and covers the band Owns
+      // decides exactly.
+      const int widen = this->ExactBounds || offLattice ? 0 : 1;
       if (empty || xlo > xhi + widen)
       {
         continue;
