@@ -592,7 +592,7 @@ void DropVoxelOwners(vtkDataObject* object)
   object->GetFieldData()->RemoveArray(names::VoxelOwnerDigest);
 }
 
-bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, std::vector<std::int32_t>& owner)
+bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, VoxelOwnerMap& owner)
 {
   vtkIntArray* array = vtkIntArray::SafeDownCast(mesh->GetFieldData()->GetAbstractArray(names::VoxelOwner));
   vtkTypeUInt64Array* digest = vtkTypeUInt64Array::SafeDownCast(mesh->GetFieldData()->GetAbstractArray(names::VoxelOwnerDigest));
@@ -608,7 +608,7 @@ bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, std::ve
   {
     return false;
   }
-  owner.assign(p, p + voxels);
+  owner.View(p, voxels, std::make_shared<vtkSmartPointer<vtkIntArray>>(array));
   return true;
 }
 

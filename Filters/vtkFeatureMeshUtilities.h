@@ -140,7 +140,8 @@ vtkSmartPointer<vtkIntArray> NewVoxelOwnerArray(std::int64_t voxels);
 void AttachVoxelOwners(vtkUnstructuredGrid* mesh, vtkIntArray* owner);
 // The owner map attached to `mesh` when it has `voxels` tuples and was made for the mesh's points and
 // cells as they are now; else false (the caller rasterises).
-bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, std::vector<std::int32_t>& owner);
+// `owner` views the array (no copy) and keeps it alive.
+bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, VoxelOwnerMap& owner);
 // Removes the owner map from a copy that is no longer an image mesh (a labelled mesh, a moved one).
 void DropVoxelOwners(vtkDataObject* object);
 // A 64-bit digest of a grid's points and cells as stored.

@@ -18,6 +18,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace featuremesh
@@ -73,6 +74,45 @@ struct ElementStatistics
 template <typename T>
 ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, const T* values,
   const ParallelFor& parallel, const ProgressFunction& progress = NoProgress(), std::int32_t* owner = nullptr);
+
+// The element owning each voxel (-1 none): a map of its own (VoxelOwners) or a view of one its
+// holder keeps alive (stage 2's array: no 36 MB copy on BraTS). Move-only: a view stays valid.
+class VoxelOwnerMap
+{
+public:
+  VoxelOwnerMap() = default;
+  VoxelOwnerMap(VoxelOwnerMap&&) = default;
+  VoxelOwnerMap& operator=(VoxelOwnerMap&&) = default;
+  VoxelOwnerMap(const VoxelOwnerMap&) = delete;
+  VoxelOwnerMap& operator=(const VoxelOwnerMap&) = delete;
+
+  void Own(std::vector<std::int32_t> owner)
+  {
+    this->Keep.reset();
+    this->Owned = std::move(owner);
+    this->P = this->Owned.data();
+    this->N = static_cast<std::int64_t>(this->Owned.size());
+  }
+  void View(const std::int32_t* owner, std::int64_t voxels, std::shared_ptr<const void> keep)
+  {
+    std::vector<std::int32_t>().swap(this->Owned);
+    this->Keep = std::move(keep);
+    this->P = owner;
+    this->N = voxels;
+  }
+  const std::int32_t* data() const { return this->P; }
+  std::int64_t size() const { return this->N; }
+  bool empty() const { return this->N == 0; }
+  const std::int32_t* begin() const { return this->P; }
+  const std::int32_t* end() const { return this->P + this->N; }
+  std::int32_t operator[](std::int64_t v) const { return this->P[v]; }
+
+private:
+  std::vector<std::int32_t> Owned;
+  std::shared_ptr<const void> Keep;
+  const std::int32_t* P = nullptr;
+  std::int64_t N = 0;
+};
 
 // Owner element of every voxel (-1 where none, which only happens when the mesh does not tile the box).
 // Empty when progress asked to abort. Element ids are 32-bit: 4 bytes per voxel.

@@ -7,7 +7,7 @@
 
 namespace featuremesh
 {
-bool SeedConstraints(const std::vector<std::int32_t>& owner, const std::vector<std::int64_t>& objectVoxels,
+bool SeedConstraints(const VoxelOwnerMap& owner, const std::vector<std::int64_t>& objectVoxels,
   const std::vector<std::int64_t>& backgroundVoxels, const char* node, std::vector<std::uint8_t>& hard,
   std::string& error)
 {
@@ -82,7 +82,7 @@ bool PrepareVoxelOwners(const SimplexMesh& mesh, SuperVoxelCutData& data, const 
 {
   if (static_cast<std::int64_t>(data.Owner.size()) != mesh.Geometry().Size())
   {
-    data.Owner = VoxelOwners(ElementRasterizer(mesh), parallel, progress);
+    data.Owner.Own(VoxelOwners(ElementRasterizer(mesh), parallel, progress));
   }
   return !data.Owner.empty();
 }
@@ -97,7 +97,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   const auto t0 = Clock::now();
   SuperVoxelCutResult result;
   const std::int64_t m = mesh.NumberOfElements();
-  const std::vector<std::int32_t>& owner = data.Owner;
+  const VoxelOwnerMap& owner = data.Owner;
   if (static_cast<std::int64_t>(owner.size()) != mesh.Geometry().Size() ||
     (data.HasVoxelValues() && static_cast<std::int64_t>(data.Voxels.Offset.size()) != m + 1))
   {
@@ -175,7 +175,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   return result;
 }
 
-void VoxelLabels(const std::vector<std::int32_t>& owner, const std::vector<std::uint8_t>& label, std::uint8_t* out,
+void VoxelLabels(const VoxelOwnerMap& owner, const std::vector<std::uint8_t>& label, std::uint8_t* out,
   const ParallelFor& parallel)
 {
   parallel(static_cast<std::int64_t>(owner.size()), 65536, [&](std::int64_t b, std::int64_t e) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "BoykovJolly.h"
+#include "ElementRasterizer.h"
 #include "Parallel.h"
 #include "SeedConnectivity.h"
 #include "SimplexMesh.h"
@@ -55,7 +56,7 @@ struct SuperVoxelCutResult
 // Hard constraints (0 free, 1 object, 2 background) of the nodes owning the seed voxels; false
 // with a sentence when a seed voxel has no owner (-1) or a node holds seeds of both kinds.
 // `node` names a node in messages ("element", "voxel").
-bool SeedConstraints(const std::vector<std::int32_t>& owner, const std::vector<std::int64_t>& objectVoxels,
+bool SeedConstraints(const VoxelOwnerMap& owner, const std::vector<std::int64_t>& objectVoxels,
   const std::vector<std::int64_t>& backgroundVoxels, const char* node, std::vector<std::uint8_t>& hard,
   std::string& error);
 
@@ -67,8 +68,8 @@ std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale);
 // a seed edit or a parameter change reuses it.
 struct SuperVoxelCutData
 {
-  // The element owning each voxel (VoxelOwners, ElementRasterizer.h; -1 none).
-  std::vector<std::int32_t> Owner;
+  // The element owning each voxel (-1 none).
+  VoxelOwnerMap Owner;
   // Each element's voxel values; empty without voxel values.
   NodeVoxelValues Voxels;
   bool HasVoxelValues() const { return !this->Voxels.Offset.empty(); }
@@ -106,7 +107,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   MaxFlowCache* flow = nullptr);
 
 // The labels of the elements on the voxel grid, into `out` (one per owner; 0 where no element owns a voxel).
-void VoxelLabels(const std::vector<std::int32_t>& owner, const std::vector<std::uint8_t>& label, std::uint8_t* out,
+void VoxelLabels(const VoxelOwnerMap& owner, const std::vector<std::uint8_t>& label, std::uint8_t* out,
   const ParallelFor& parallel);
 
 // The voxel cut on the 4-/6-connected grid, each neighbour pair one voxel face; `values` (one per

@@ -612,7 +612,7 @@ TEST(SuperVoxelCut, ContactAndHardConstraintsOnFourTriangles)
   SuperVoxelCutData data;
   std::string prepareError;
   ASSERT_TRUE(PrepareSuperVoxelCut(mesh, static_cast<const double*>(nullptr), data, prepareError, SerialFor()));
-  const std::vector<std::int32_t>& owner = data.Owner;
+  const VoxelOwnerMap& owner = data.Owner;
   const ImageGeometry& g = mesh.Geometry();
   std::vector<std::uint8_t> hard(4, 0);
   std::string error;
