@@ -1,4 +1,5 @@
 #include "vtkFeatureMeshUtilities.h"
+#include "Memory.h"
 
 #include "Contract.h"
 
@@ -540,6 +541,7 @@ vtkSmartPointer<vtkIntArray> NewVoxelOwnerArray(std::int64_t voxels)
   auto owner = vtkSmartPointer<vtkIntArray>::New();
   owner->SetName(names::VoxelOwner);
   owner->SetNumberOfTuples(static_cast<vtkIdType>(voxels));
+  AdviseHugePages(owner->GetPointer(0), static_cast<std::size_t>(voxels) * sizeof(std::int32_t));
   return owner;
 }
 

@@ -1,4 +1,5 @@
 #include "BoykovJolly.h"
+#include "Memory.h"
 
 #include <maxflow.h>
 
@@ -186,10 +187,12 @@ bool GroupVoxelValues(const std::int32_t* owner, const T* values, std::int64_t v
   {
     grouped.Double.reset();
     grouped.Single.reset(new float[total]);
+    AdviseHugePages(grouped.Single.get(), total * sizeof(float));
     return scatterAndSort(grouped.Single.get());
   }
   grouped.Single.reset();
   grouped.Double.reset(new double[total]);
+  AdviseHugePages(grouped.Double.get(), total * sizeof(double));
   return scatterAndSort(grouped.Double.get());
 }
 #define FEATUREMESH_GROUP_VOXEL_VALUES(T)                                                                        \
@@ -410,6 +413,8 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   // Not zero-filled unless summed into: a 9 M-voxel graph's pages are first touched in loops that
   // report progress.
   std::unique_ptr<double[]> regionObject(new double[n]), regionBackground(new double[n]);
+  AdviseHugePages(regionObject.get(), n * sizeof(double));
+  AdviseHugePages(regionBackground.get(), n * sizeof(double));
   if (exact)
   {
     // Each node's values are sorted and bin() is monotone: a node within one bin costs two reads,

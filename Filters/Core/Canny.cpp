@@ -1,4 +1,5 @@
 #include "Canny.h"
+#include "Memory.h"
 
 #include "ImagingInternals.h"
 
@@ -38,7 +39,8 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const ImageGeometry& g, dou
   {
     *gradientMaximum = gmax;
   }
-  std::vector<std::uint8_t> state(n, 0); // 0 none, 1 weak candidate, 2 strong
+  std::vector<std::uint8_t> state; // 0 none, 1 weak candidate, 2 strong
+  AssignFresh(state, n, std::uint8_t(0));
   if (gmax <= 0.0)
   {
     return state;

@@ -1,4 +1,5 @@
 #include "FeatureNodes.h"
+#include "Memory.h"
 
 #include "Canny.h"
 #include "EdgeSampling.h"
@@ -164,6 +165,8 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
   std::unique_ptr<float[]> bufferA(new float[n]), bufferB(new float[n]);
   float* f = bufferA.get();
   float* work = bufferB.get();
+  AdviseHugePages(f, n * sizeof(float));
+  AdviseHugePages(work, n * sizeof(float));
   auto t0 = Clock::now();
   // The recipe is scale-invariant (thresholds are fractions of maxima), and scaling by a power of
   // two is exact: images of extreme magnitude, whose gradients would overflow or underflow float,
@@ -270,7 +273,8 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
   }
 
   // Node occupancy, one node per voxel: boundary nodes claim first, then Canny, halftone, uniform.
-  std::vector<std::uint8_t> occupied(n, 0);
+  std::vector<std::uint8_t> occupied;
+  AssignFresh(occupied, n, std::uint8_t(0));
   auto add = [&](int i, int j, int k, NodeType type, float radius) {
     const std::int64_t idx = g.Index(i, j, k);
     if (occupied[idx])

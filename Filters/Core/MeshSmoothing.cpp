@@ -1,4 +1,5 @@
 #include "MeshSmoothing.h"
+#include "Memory.h"
 
 #include "DelaunayMesh.h"
 #include "ElementRasterizer.h"
@@ -628,7 +629,7 @@ MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<s
   double meanGradient = 0.0;
   if ((p.FeatureWeight != 0.0 || slide) && p.Iterations > 0)
   {
-    smoothed.resize(static_cast<size_t>(g.Size()));
+    AssignFresh(smoothed, static_cast<size_t>(g.Size()));
     GaussianSmooth(values, smoothed.data(), g, p.Sigma, parallel);
     if (!progress(0.0))
     {
@@ -638,7 +639,7 @@ MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<s
   }
   if (p.FeatureWeight != 0.0 && p.Iterations > 0)
   {
-    gradient.resize(smoothed.size());
+    AssignFresh(gradient, smoothed.size());
     GradientMagnitude(smoothed.data(), g, gradient.data(), parallel);
     meanGradient = std::accumulate(gradient.begin(), gradient.end(), 0.0) / static_cast<double>(gradient.size());
   }

@@ -1,4 +1,5 @@
 #include "RSPEdgeEnhancement.h"
+#include "Memory.h"
 
 #include "ImageFilters.h"
 
@@ -141,8 +142,10 @@ std::vector<float> FastMarching(const float* slowness, const ImageGeometry& g, c
   const std::int64_t n = g.Size();
   const Grid grid(g.Dims);
   const std::array<double, 3> h = AxisSteps(g);
-  std::vector<double> T(static_cast<std::size_t>(n), std::numeric_limits<double>::infinity());
-  std::vector<std::uint8_t> known(static_cast<std::size_t>(n), 0);
+  std::vector<double> T;
+  std::vector<std::uint8_t> known;
+  AssignFresh(T, static_cast<std::size_t>(n), std::numeric_limits<double>::infinity());
+  AssignFresh(known, static_cast<std::size_t>(n), std::uint8_t(0));
   std::vector<std::int64_t> targets;
   if (medianOf && median && stopAt <= 0.0)
   {
@@ -240,7 +243,8 @@ std::vector<float> FastMarching(const float* slowness, const ImageGeometry& g, c
       }
     }
   }
-  std::vector<float> out(static_cast<std::size_t>(n), Infinity);
+  std::vector<float> out;
+  AssignFresh(out, static_cast<std::size_t>(n), Infinity);
   for (std::int64_t i = 0; i < n; ++i)
   {
     if (known[i])
@@ -488,10 +492,10 @@ RSPResult OnCoarserGrid(const float* image, const ImageGeometry& g, const std::v
   out.Paths = r.Paths;
   out.PathVoxels = r.PathVoxels;
   const std::int64_t n = g.Size();
-  out.EdgeConfidence.resize(static_cast<std::size_t>(n));
-  out.EdgeMap.resize(static_cast<std::size_t>(n));
-  out.ObjectDistance.resize(static_cast<std::size_t>(n));
-  out.BackgroundDistance.resize(static_cast<std::size_t>(n));
+  AssignFresh(out.EdgeConfidence, static_cast<std::size_t>(n));
+  AssignFresh(out.EdgeMap, static_cast<std::size_t>(n));
+  AssignFresh(out.ObjectDistance, static_cast<std::size_t>(n));
+  AssignFresh(out.BackgroundDistance, static_cast<std::size_t>(n));
   // Row by row without divisions.
   const float scale = static_cast<float>(f);
   parallel(static_cast<std::int64_t>(g.Dims[1]) * g.Dims[2], 64, [&](std::int64_t r0, std::int64_t r1) {
@@ -585,7 +589,9 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
     out.Error = "the image is constant: it has no edges to enhance.";
     return out;
   }
-  std::vector<float> cost(static_cast<std::size_t>(n)), slowness(static_cast<std::size_t>(n));
+  std::vector<float> cost, slowness;
+  AssignFresh(cost, static_cast<std::size_t>(n));
+  AssignFresh(slowness, static_cast<std::size_t>(n));
   if (p.GradientSigma > 0.0)
   {
     GaussianSmooth(image, slowness.data(), g, p.GradientSigma, parallel);
@@ -828,7 +834,7 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
     return out;
   }
   out.Paths = nSources * static_cast<std::int64_t>(sinks.size());
-  out.EdgeConfidence.assign(static_cast<std::size_t>(n), 0.f);
+  AssignFresh(out.EdgeConfidence, static_cast<std::size_t>(n), 0.f);
   for (std::int64_t l = 0; l < box.Size(); ++l)
   {
     std::uint64_t c = 0;
