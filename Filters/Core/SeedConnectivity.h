@@ -23,20 +23,21 @@ enum class Connectivity : int
 };
 
 // Components of equal label over the edges A[i]-B[i]: an id per node, numbered in order of each
-// component's first node (deterministic); `count` receives their number.
+// component's first node (deterministic); `count` receives their number. Empty when `progress`
+// (asked every 2^18 edges: a voxel graph has tens of millions) aborts.
 std::vector<std::int64_t> LabelComponents(
   const std::vector<std::uint8_t>& label, const std::vector<std::int64_t>& A, const std::vector<std::int64_t>& B,
-  std::int64_t& count);
+  std::int64_t& count, const ProgressFunction& progress = NoProgress());
 
 // Applies `mode` to `label` (1 object, 0 background) in place; `hard` (0 free, 1 object seed, 2
 // background seed) and `border` (node touches the image border) per node. Seeded nodes keep their
-// label. Returns how many nodes changed, or -1 when `progress` (asked between passes) aborts.
+// label. Returns how many nodes changed, or -1 when `progress` aborts.
 std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label,
   const std::vector<std::int64_t>& A, const std::vector<std::int64_t>& B, const std::vector<std::uint8_t>& hard,
   const std::vector<std::uint8_t>& border, const ProgressFunction& progress = NoProgress());
 
 // The sizes of the object components (sum of `size` over their nodes, 1 per node when `size` is
-// empty), largest first.
+// empty), largest first; empty when `progress` aborts.
 std::vector<double> ObjectComponentSizes(const std::vector<std::uint8_t>& label, const std::vector<std::int64_t>& A,
-  const std::vector<std::int64_t>& B, const std::vector<double>& size);
+  const std::vector<std::int64_t>& B, const std::vector<double>& size, const ProgressFunction& progress = NoProgress());
 } // namespace featuremesh

@@ -277,7 +277,7 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
     aborted.Aborted = true;
     return aborted;
   }
-  cut.ObjectComponentVoxels = ObjectComponentSizes(cut.Label, pr.A, pr.B, std::vector<double>());
+  cut.ObjectComponentVoxels = ObjectComponentSizes(cut.Label, pr.A, pr.B, std::vector<double>(), SubProgress(progress, 0.98, 1.0));
   cut.Aborted = !progress(1.0);
   return cut;
 }
