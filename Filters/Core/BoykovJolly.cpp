@@ -390,20 +390,26 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     return r;
   }
 
-  // Not zero-filled: its pages are first touched in the loop below, which reports progress.
+  // Not zero-filled: its pages are first touched in the loop below, which reports progress. The
+  // exponentials run on pr.Parallel; the sum stays in edge order (the same total for any split).
   std::unique_ptr<double[]> weight(new double[m]);
+  if (!BatchedFor(m, 16384, pr.Parallel, SubProgress(progress, 0.1, 0.2), [&](std::int64_t first, std::int64_t last) {
+        for (std::int64_t e = first; e < last; ++e)
+        {
+          const double d = pr.Value[pr.A[e]] - pr.Value[pr.B[e]];
+          // Equal neighbours have weight 1 whatever sigma (a tiny sigma would give 0 * inf).
+          const double contact = pr.Contact.empty() ? 1.0 : pr.Contact[e];
+          weight[e] = contact * (d == 0.0 ? 1.0 : std::exp(-d * d * inv2s2));
+        }
+      }))
+  {
+    r.Aborted = true;
+    return r;
+  }
   double total = 1.0;
   for (std::int64_t e = 0; e < m; ++e)
   {
-    const double d = pr.Value[pr.A[e]] - pr.Value[pr.B[e]];
-    // Equal neighbours have weight 1 whatever sigma (a tiny sigma would give 0 * inf).
-    const double contact = pr.Contact.empty() ? 1.0 : pr.Contact[e];
-    weight[e] = contact * (d == 0.0 ? 1.0 : std::exp(-d * d * inv2s2));
     total += weight[e];
-    if (aborted(e, m, 0.1, 0.2))
-    {
-      return r;
-    }
   }
   if (phaseAborted(0.2))
   {
