@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <utility>
 #include <numeric>
 
 namespace featuremesh
@@ -63,47 +64,130 @@ std::vector<std::int64_t> LabelComponents(const std::vector<std::uint8_t>& label
 
 std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label,
   const std::vector<std::int64_t>& A, const std::vector<std::int64_t>& B, const std::vector<std::uint8_t>& hard,
-  const std::vector<std::uint8_t>& border, const ProgressFunction& progress)
+  const std::vector<std::uint8_t>& border, const ProgressFunction& progress, std::vector<double>* objectSizes,
+  const std::vector<double>& size)
 {
-  if (mode == Connectivity::Off)
+  if (mode == Connectivity::Off && !objectSizes)
   {
     return 0;
   }
+  // One pass over the edges: the components of equal label. Every later step relabels or joins
+  // whole components, over the (few) edges between labels.
   const std::int64_t n = static_cast<std::int64_t>(label.size());
-  std::int64_t changed = 0, count = 0;
-  // Relabels every node of a component of label `from` that `keep` does not mark; false on abort.
-  auto relabel = [&](std::uint8_t from, const std::function<bool(std::int64_t)>& anchors, const ProgressFunction& part) {
-    const std::vector<std::int64_t> id = LabelComponents(label, A, B, count, part);
-    if (static_cast<std::int64_t>(id.size()) != n)
-    {
-      return false;
-    }
-    std::vector<std::uint8_t> keep(count, 0);
-    for (std::int64_t p = 0; p < n; ++p)
-    {
-      if (label[p] == from && anchors(p))
-      {
-        keep[id[p]] = 1;
-      }
-    }
-    for (std::int64_t p = 0; p < n; ++p)
-    {
-      if (label[p] == from && !keep[id[p]])
-      {
-        label[p] = from ? 0 : 1;
-        ++changed;
-      }
-    }
-    return true;
-  };
-  const bool seeded = mode == Connectivity::SeededObject;
-  if (seeded && (!relabel(1, [&](std::int64_t p) { return hard[p] == 1; }, SubProgress(progress, 0.0, 0.5)) || !progress(0.5)))
+  std::int64_t count = 0;
+  const std::vector<std::int64_t> id = LabelComponents(label, A, B, count, SubProgress(progress, 0.0, 0.8));
+  if (static_cast<std::int64_t>(id.size()) != n)
   {
     return -1;
   }
-  if (!relabel(0, [&](std::int64_t p) { return hard[p] == 2 || border[p]; }, SubProgress(progress, seeded ? 0.5 : 0.0, 1.0)))
+  const bool rules = mode != Connectivity::Off;
+  std::vector<std::uint8_t> value(count, 0), objectSeed(count, 0), anchored(count, 0);
+  std::vector<std::int64_t> nodes(count, 0);
+  std::vector<double> weight(count, 0.0);
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    const std::int64_t c = id[p];
+    value[c] = label[p];
+    ++nodes[c];
+    weight[c] += size.empty() ? 1.0 : size[p];
+    if (rules)
+    {
+      objectSeed[c] |= hard[p] == 1 ? 1 : 0;
+      anchored[c] |= hard[p] == 2 || border[p] ? 1 : 0;
+    }
+  }
+  // Components meeting across an edge: always of different labels.
+  std::vector<std::pair<std::int64_t, std::int64_t>> meet;
+  for (std::size_t e = 0; e < A.size(); ++e)
+  {
+    const std::int64_t a = id[A[e]], b = id[B[e]];
+    if (a != b)
+    {
+      meet.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  }
+  std::sort(meet.begin(), meet.end());
+  meet.erase(std::unique(meet.begin(), meet.end()), meet.end());
+  if (!progress(0.9))
   {
     return -1;
+  }
+  // The root of each component once components of label `v` that meet are joined.
+  const auto joined = [&](std::uint8_t v) {
+    std::vector<std::int64_t> root(count);
+    std::iota(root.begin(), root.end(), std::int64_t(0));
+    for (const auto& m : meet)
+    {
+      if (value[m.first] == v && value[m.second] == v)
+      {
+        std::int64_t a = Find(root, m.first), b = Find(root, m.second);
+        if (a != b)
+        {
+          root[std::max(a, b)] = std::min(a, b);
+        }
+      }
+    }
+    for (std::int64_t c = 0; c < count; ++c)
+    {
+      root[c] = Find(root, c);
+    }
+    return root;
+  };
+  std::int64_t changed = 0;
+  if (mode == Connectivity::SeededObject)
+  {
+    for (std::int64_t c = 0; c < count; ++c)
+    {
+      if (value[c] == 1 && !objectSeed[c])
+      {
+        value[c] = 0;
+        changed += nodes[c];
+      }
+    }
+  }
+  if (rules)
+  {
+    // Background regions (joined through what the seeded rule relabelled) with no background seed
+    // and no border node are holes.
+    const std::vector<std::int64_t> root = joined(0);
+    std::vector<std::uint8_t> keep(count, 0);
+    for (std::int64_t c = 0; c < count; ++c)
+    {
+      keep[root[c]] |= value[c] == 0 && anchored[c] ? 1 : 0;
+    }
+    for (std::int64_t c = 0; c < count; ++c)
+    {
+      if (value[c] == 0 && !keep[root[c]])
+      {
+        value[c] = 1;
+        changed += nodes[c];
+      }
+    }
+    for (std::int64_t p = 0; p < n; ++p)
+    {
+      label[p] = value[id[p]];
+    }
+  }
+  if (objectSizes)
+  {
+    const std::vector<std::int64_t> root = joined(1);
+    std::vector<double> sum(count, 0.0);
+    for (std::int64_t c = 0; c < count; ++c)
+    {
+      if (value[c] == 1)
+      {
+        sum[root[c]] += weight[c];
+      }
+    }
+    objectSizes->clear();
+    for (std::int64_t c = 0; c < count; ++c)
+    {
+      if (value[c] == 1 && root[c] == c)
+      {
+        objectSizes->push_back(sum[c]);
+      }
+    }
+    std::sort(objectSizes->begin(), objectSizes->end(), std::greater<double>());
   }
   return progress(1.0) ? changed : -1;
 }
@@ -111,28 +195,9 @@ std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& lab
 std::vector<double> ObjectComponentSizes(const std::vector<std::uint8_t>& label, const std::vector<std::int64_t>& A,
   const std::vector<std::int64_t>& B, const std::vector<double>& size, const ProgressFunction& progress)
 {
-  std::int64_t count = 0;
-  const std::vector<std::int64_t> id = LabelComponents(label, A, B, count, progress);
-  if (id.size() != label.size())
-  {
-    return {};
-  }
-  std::vector<double> sizes(count, 0.0);
-  std::vector<std::uint8_t> isObject(count, 0);
-  for (std::size_t p = 0; p < label.size(); ++p)
-  {
-    sizes[id[p]] += size.empty() ? 1.0 : size[p];
-    isObject[id[p]] = label[p];
-  }
-  std::vector<double> object;
-  for (std::int64_t c = 0; c < count; ++c)
-  {
-    if (isObject[c])
-    {
-      object.push_back(sizes[c]);
-    }
-  }
-  std::sort(object.begin(), object.end(), std::greater<double>());
-  return object;
+  std::vector<std::uint8_t> unchanged(label);
+  std::vector<double> sizes;
+  return ApplyConnectivity(Connectivity::Off, unchanged, A, B, {}, {}, progress, &sizes, size) < 0 ? std::vector<double>() : sizes;
 }
+
 } // namespace featuremesh

@@ -31,10 +31,13 @@ std::vector<std::int64_t> LabelComponents(
 
 // Applies `mode` to `label` (1 object, 0 background) in place; `hard` (0 free, 1 object seed, 2
 // background seed) and `border` (node touches the image border) per node. Seeded nodes keep their
-// label. Returns how many nodes changed, or -1 when `progress` aborts.
+// label. Returns how many node relabellings it made (a node the seeded rule drops and hole filling
+// takes back counts twice), or -1 when `progress` aborts. `objectSizes` (optional) receives the
+// sizes of the resulting object components as ObjectComponentSizes gives them, from the same pass.
 std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label,
   const std::vector<std::int64_t>& A, const std::vector<std::int64_t>& B, const std::vector<std::uint8_t>& hard,
-  const std::vector<std::uint8_t>& border, const ProgressFunction& progress = NoProgress());
+  const std::vector<std::uint8_t>& border, const ProgressFunction& progress = NoProgress(),
+  std::vector<double>* objectSizes = nullptr, const std::vector<double>& size = {});
 
 // The sizes of the object components (sum of `size` over their nodes, 1 per node when `size` is
 // empty), largest first; empty when `progress` aborts.

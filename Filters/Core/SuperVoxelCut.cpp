@@ -168,9 +168,8 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   {
     border[e] = 1;
   }
-  result.Cut.ConnectivityChanged =
-    ApplyConnectivity(parameters.Connectivity, result.Cut.Label, adj.A, adj.B, pr.Hard, border);
-  result.Cut.ObjectComponentVoxels = ObjectComponentSizes(result.Cut.Label, adj.A, adj.B, voxelCount);
+  result.Cut.ConnectivityChanged = ApplyConnectivity(parameters.Connectivity, result.Cut.Label, adj.A, adj.B, pr.Hard,
+    border, NoProgress(), &result.Cut.ObjectComponentVoxels, voxelCount);
   result.BoundaryFaces = LabelBoundaryFaces(mesh, result.Cut.Label);
   return result;
 }
@@ -269,16 +268,14 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
         border[g.Index(i, j, k)] = i == 0 || j == 0 || i + 1 == g.Dims[0] || j + 1 == g.Dims[1] ||
           (!g.Is2D() && (k == 0 || k + 1 == g.Dims[2]));
       }
-  cut.ConnectivityChanged = ApplyConnectivity(
-    parameters.Connectivity, cut.Label, pr.A, pr.B, pr.Hard, border, SubProgress(progress, 0.95, 0.98));
+  cut.ConnectivityChanged = ApplyConnectivity(parameters.Connectivity, cut.Label, pr.A, pr.B, pr.Hard, border,
+    SubProgress(progress, 0.95, 1.0), &cut.ObjectComponentVoxels);
   if (cut.ConnectivityChanged < 0)
   {
     CutResult aborted;
     aborted.Aborted = true;
     return aborted;
   }
-  cut.ObjectComponentVoxels = ObjectComponentSizes(cut.Label, pr.A, pr.B, std::vector<double>(), SubProgress(progress, 0.98, 1.0));
-  cut.Aborted = !progress(1.0);
   return cut;
 }
 } // namespace featuremesh
