@@ -3,8 +3,8 @@
 
 #include <algorithm>
 #include <functional>
-#include <utility>
 #include <numeric>
+#include <utility>
 
 namespace featuremesh
 {
