@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <stdexcept>
@@ -299,6 +300,85 @@ struct MaxFlowCache::Kept
   std::vector<double> Weight, Source, Sink;
 };
 
+// Node p's voxel values as runs of one bin (ascending) at [Offset[p], Offset[p + 1]), for the bins
+// of width Width from Low; empty until a binning repeats.
+struct MaxFlowCache::BinnedVoxels
+{
+  const NodeVoxelValues* From = nullptr;
+  std::size_t Nodes = 0;
+  int Bins = 0;
+  double Low = 0.0, Width = 0.0;
+  std::vector<std::int64_t> Offset;
+  std::vector<std::uint16_t> Bin;
+  std::vector<std::uint32_t> Count;
+  bool Matches(const NodeVoxelValues* from, int bins, double low, double width) const
+  {
+    return this->From == from && this->Nodes == from->Offset.size() && this->Bins == bins &&
+      this->Low == low && this->Width == width;
+  }
+  bool Empty() const { return this->Offset.empty(); }
+};
+
+namespace
+{
+// The runs of one bin in sorted values: bin() is monotone, so a node within one bin costs two reads,
+// one spanning several a binary search per bin. f(bin, count), bins ascending.
+template <typename Stored, typename BinFunction, typename RunFunction>
+void ForEachRun(const Stored* x, const Stored* end, int bins, const BinFunction& bin, const RunFunction& f)
+{
+  while (x < end)
+  {
+    const int b = bin(*x);
+    const Stored* next =
+      b == bins - 1 || bin(end[-1]) == b ? end : std::partition_point(x, end, [&](Stored y) { return bin(y) <= b; });
+    constexpr std::int64_t longest = std::numeric_limits<std::uint32_t>::max();
+    for (std::int64_t left = next - x; left > 0; left -= longest)
+    {
+      f(b, static_cast<std::uint32_t>(std::min(left, longest)));
+    }
+    x = next;
+  }
+}
+
+// Every node's voxel values as bin runs, in two passes over them (count, then write). False when
+// progress asked to abort.
+template <typename BinFunction>
+bool BinVoxels(const NodeVoxelValues& voxels, const BinFunction& bin, MaxFlowCache::BinnedVoxels& binned,
+  const ParallelFor& parallel, const ProgressFunction& progress)
+{
+  const std::int64_t n = static_cast<std::int64_t>(voxels.Offset.size()) - 1;
+  std::vector<std::int64_t>& offset = binned.Offset;
+  AssignFresh(offset, static_cast<std::size_t>(n + 1), std::int64_t(0));
+  return voxels.Visit([&](const auto* all) {
+    auto runs = [&](std::int64_t p, const auto& f) {
+      ForEachRun(all + voxels.Offset[p], all + voxels.Offset[p + 1], binned.Bins, bin, f);
+    };
+    if (!BatchedFor(n, 8192, parallel, SubProgress(progress, 0.0, 0.5), [&](std::int64_t first, std::int64_t last) {
+          for (std::int64_t p = first; p < last; ++p)
+          {
+            runs(p, [&](int, std::uint32_t) { ++offset[p + 1]; });
+          }
+        }))
+    {
+      return false;
+    }
+    std::partial_sum(offset.begin(), offset.end(), offset.begin());
+    AssignFresh(binned.Bin, static_cast<std::size_t>(offset[n]));
+    AssignFresh(binned.Count, static_cast<std::size_t>(offset[n]));
+    return BatchedFor(n, 8192, parallel, SubProgress(progress, 0.5, 1.0), [&](std::int64_t first, std::int64_t last) {
+      for (std::int64_t p = first; p < last; ++p)
+      {
+        std::int64_t k = offset[p];
+        runs(p, [&](int b, std::uint32_t count) {
+          binned.Bin[k] = static_cast<std::uint16_t>(b);
+          binned.Count[k++] = count;
+        });
+      }
+    });
+  });
+}
+} // namespace
+
 CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par, const ProgressFunction& progress,
   MaxFlowCache* cache)
 {
@@ -423,30 +503,57 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   AdviseHugePages(regionBackground.get(), n * sizeof(double));
   if (exact)
   {
-    // Each node's values are sorted and bin() is monotone: a node within one bin costs two reads,
-    // one spanning several a binary search per bin.
-    const bool done = exact->Visit([&](const auto* all) {
-      return BatchedFor(n, 8192, pr.Parallel, SubProgress(progress, 0.2, 0.3), [&](std::int64_t first, std::int64_t last) {
-        for (std::int64_t p = first; p < last; ++p)
-        {
-          double sumObject = 0.0, sumBackground = 0.0;
-          using Stored = std::remove_cv_t<std::remove_pointer_t<decltype(all)>>;
-          for (const Stored *x = all + exact->Offset[p], *end = all + exact->Offset[p + 1]; x < end;)
-          {
-            const int b = bin(*x);
-            const Stored* next = b == r.Bins - 1 || bin(end[-1]) == b
-              ? end
-              : std::partition_point(x, end, [&](Stored y) { return bin(y) <= b; });
-            const double count = static_cast<double>(next - x);
-            sumObject += count * costObject[b];
-            sumBackground += count * costBackground[b];
-            x = next;
-          }
-          regionObject[p] = sumObject;
-          regionBackground[p] = sumBackground;
-        }
-      });
-    });
+    // The bins move only when a seed sample leaves the last cut's range. A binning seen for the first
+    // time is summed straight from the values; one that repeats is kept as runs, which later cuts read.
+    std::shared_ptr<MaxFlowCache::BinnedVoxels> binned = cache ? cache->Binned : nullptr;
+    const bool repeated = binned && binned->Matches(exact, r.Bins, low, width);
+    if (cache && !repeated)
+    {
+      binned = std::make_shared<MaxFlowCache::BinnedVoxels>();
+      binned->From = exact;
+      binned->Nodes = exact->Offset.size();
+      binned->Bins = r.Bins;
+      binned->Low = low;
+      binned->Width = width;
+      cache->Binned = binned;
+    }
+    else if (repeated && binned->Empty() &&
+      !BinVoxels(*exact, bin, *binned, pr.Parallel, SubProgress(progress, 0.2, 0.28)))
+    {
+      cache->Binned.reset();
+      r.Aborted = true;
+      return r;
+    }
+    const bool done = repeated
+      ? BatchedFor(n, 16384, pr.Parallel, SubProgress(progress, 0.28, 0.3),
+          [&](std::int64_t first, std::int64_t last) {
+            for (std::int64_t p = first; p < last; ++p)
+            {
+              double sumObject = 0.0, sumBackground = 0.0;
+              for (std::int64_t k = binned->Offset[p]; k < binned->Offset[p + 1]; ++k)
+              {
+                const double count = static_cast<double>(binned->Count[k]);
+                sumObject += count * costObject[binned->Bin[k]];
+                sumBackground += count * costBackground[binned->Bin[k]];
+              }
+              regionObject[p] = sumObject;
+              regionBackground[p] = sumBackground;
+            }
+          })
+      : exact->Visit([&](const auto* all) {
+          return BatchedFor(n, 8192, pr.Parallel, SubProgress(progress, 0.2, 0.3), [&](std::int64_t first, std::int64_t last) {
+            for (std::int64_t p = first; p < last; ++p)
+            {
+              double sumObject = 0.0, sumBackground = 0.0;
+              ForEachRun(all + exact->Offset[p], all + exact->Offset[p + 1], r.Bins, bin, [&](int b, std::uint32_t count) {
+                sumObject += static_cast<double>(count) * costObject[b];
+                sumBackground += static_cast<double>(count) * costBackground[b];
+              });
+              regionObject[p] = sumObject;
+              regionBackground[p] = sumBackground;
+            }
+          });
+        });
     if (!done)
     {
       r.Aborted = true;
@@ -495,7 +602,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   std::shared_ptr<MaxFlowCache::Kept> kept = cache ? cache->State : nullptr;
   if (cache)
   {
-    cache->Clear(); // until this cut's flow has finished
+    cache->State.reset(); // until this cut's flow has finished
   }
   const bool reuse = kept && kept->A == pr.A && kept->B == pr.B && kept->Source.size() == static_cast<size_t>(n) &&
     std::equal(kept->Weight.begin(), kept->Weight.end(), weight.get(), weight.get() + m);

@@ -100,19 +100,28 @@ std::string ValidateParameters(const BoykovJollyParameters& p);
 std::vector<double> SmoothedHistogram(const std::vector<double>& samples, const std::vector<double>& weights,
   double low, double high, int bins, double bandwidth = 1.0);
 
-// A max-flow kept between cuts of one graph (Kohli and Torr's dynamic graph cuts): when the next cut
-// differs only in terminal capacities (a seed edit), it starts from this flow and its search trees
-// instead of from zero. Any other change starts afresh. Not for sharing between threads.
+// What one cut keeps for the next cut of the same graph and node voxels. The max-flow (Kohli and
+// Torr's dynamic graph cuts): when the next cut differs only in terminal capacities (a seed edit), it
+// starts from this flow and its search trees instead of from zero; any other change starts afresh.
+// The node voxels as runs of the histogram's bins, once a binning repeats (the bins move only when
+// a seed sample leaves the last range): the voxel region term then costs a read per bin a node
+// spans, not a search through its values. Not for sharing between threads.
 class MaxFlowCache
 {
 public:
-  void Clear() { this->State.reset(); }
+  void Clear()
+  {
+    this->State.reset();
+    this->Binned.reset();
+  }
   bool Empty() const { return !this->State; }
   struct Kept;
+  struct BinnedVoxels;
 
 private:
   friend CutResult BoykovJollyCut(const CutProblem&, const BoykovJollyParameters&, const ProgressFunction&, MaxFlowCache*);
   std::shared_ptr<Kept> State;
+  std::shared_ptr<BinnedVoxels> Binned;
 };
 
 // Every input is checked first (finite values within +-1e150, non-negative sizes and contacts,

@@ -510,6 +510,58 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   EXPECT_EQ(exact.Label[2], 1);
 }
 
+TEST(BoykovJolly, KeptCutsEqualFreshCuts)
+{
+  // 60 super-nodes of 1-40 noisy voxels each (spanning several bins), object-like first; a chain of
+  // seed edits through one MaxFlowCache: a binning seen first (summed from the values), the same
+  // binning again (kept as runs), read from the runs, a seed sample beyond the range (a new binning),
+  // and a parameter change. Each cut equals a fresh one: the same labels and flow.
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 3.0);
+  std::uniform_int_distribution<int> count(1, 40);
+  std::vector<double> mean, voxels;
+  std::vector<std::int32_t> owner;
+  for (int p = 0; p < 60; ++p)
+  {
+    const int c = count(rng);
+    double sum = 0.0;
+    for (int k = 0; k < c; ++k)
+    {
+      voxels.push_back((p < 25 ? 20.0 : 5.0) + noise(rng));
+      owner.push_back(p);
+      sum += voxels.back();
+    }
+    mean.push_back(sum / c);
+  }
+  CutProblem pr = SeededChain(mean);
+  NodeVoxelValues grouped;
+  std::string error;
+  ASSERT_TRUE(GroupVoxelValues(owner.data(), voxels.data(), static_cast<std::int64_t>(voxels.size()), 60, grouped,
+    error, SerialFor()));
+  pr.NodeVoxels = &grouped;
+  BoykovJollyParameters par;
+  par.Lambda = 1.0;
+  const std::vector<std::vector<double>> objectSamples = { { 20, 22, 18, 25 }, { 20, 22, 18, 25 }, { 21, 19, 23, 17 },
+    { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 } };
+  MaxFlowCache cache;
+  for (size_t edit = 0; edit < objectSamples.size(); ++edit)
+  {
+    pr.ObjectSamples = objectSamples[edit];
+    pr.BackgroundSamples = { 5, 3, 7, 4 + static_cast<double>(edit) };
+    if (edit == 5)
+    {
+      par.Bins = 16;
+    }
+    const CutResult kept = BoykovJollyCut(pr, par, NoProgress(), &cache);
+    const CutResult fresh = BoykovJollyCut(pr, par);
+    ASSERT_TRUE(kept.Error.empty() && fresh.Error.empty()) << edit;
+    EXPECT_EQ(kept.Label, fresh.Label) << edit;
+    EXPECT_NEAR(kept.Flow, fresh.Flow, 1e-12 * fresh.Flow) << edit;
+    const auto object = std::count(kept.Label.begin(), kept.Label.end(), 1);
+    EXPECT_TRUE(object >= 22 && object <= 28) << edit << ": " << object;
+  }
+}
+
 // A rotated, offset, anisotropic frame: world -> index -> world round trips, voxel centres snap
 // back exactly, half a voxel of slack decides membership, a mirror is detected.
 TEST(ImageGeometry, OrientedFrameRoundTrips)
