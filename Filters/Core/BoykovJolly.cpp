@@ -296,8 +296,13 @@ using Flow = maxflow::Graph_DDD;
 struct MaxFlowCache::Kept
 {
   std::shared_ptr<Flow> Graph;
+  // The boundary term's inputs and what it made of them.
   std::vector<std::int64_t> A, B;
-  std::vector<double> Weight, Source, Sink;
+  std::vector<double> Value, Contact;
+  double SigmaParameter = 0.0, Sigma = 0.0, WeightTotal = 0.0;
+  std::vector<double> Weight;
+  // The terminal capacities of the last flow.
+  std::vector<double> Source, Sink;
 };
 
 // Node p's voxel values as runs of one bin (ascending) at [Offset[p], Offset[p + 1]), for the bins
@@ -449,47 +454,63 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   const double width = (high - low) / r.Bins;
   auto bin = [&](double v) { return std::min(r.Bins - 1, std::max(0, static_cast<int>((v - low) / width))); };
 
-  r.Sigma = par.Sigma;
-  if (r.Sigma <= 0.0)
+  // The boundary term depends on the graph alone: a kept flow of this very graph lends its weights
+  // (and its residual graph, below).
+  std::shared_ptr<MaxFlowCache::Kept> kept = cache ? cache->State : nullptr;
+  const bool reuse = kept && kept->SigmaParameter == par.Sigma && kept->A == pr.A && kept->B == pr.B &&
+    kept->Value == pr.Value && kept->Contact == pr.Contact;
+  std::unique_ptr<double[]> computed;
+  const double* weight = nullptr;
+  double total = 1.0;
+  if (reuse)
   {
-    double ss = 0.0;
+    r.Sigma = kept->Sigma;
+    weight = kept->Weight.data();
+    total = kept->WeightTotal;
+  }
+  else
+  {
+    r.Sigma = par.Sigma;
+    if (r.Sigma <= 0.0)
+    {
+      double ss = 0.0;
+      for (std::int64_t e = 0; e < m; ++e)
+      {
+        const double d = pr.Value[pr.A[e]] - pr.Value[pr.B[e]];
+        ss += d * d;
+      }
+      r.Sigma = m ? std::sqrt(ss / static_cast<double>(m)) : 1.0;
+      if (!(r.Sigma > 0.0))
+      {
+        r.Sigma = 1.0;
+      }
+    }
+    const double inv2s2 = 1.0 / (2.0 * r.Sigma * r.Sigma);
+    if (phaseAborted(0.1))
+    {
+      return r;
+    }
+    // Not zero-filled: its pages are first touched in the loop below, which reports progress. The
+    // exponentials run on pr.Parallel; the sum stays in edge order (the same total for any split).
+    computed.reset(new double[m]);
+    weight = computed.get();
+    if (!BatchedFor(m, 16384, pr.Parallel, SubProgress(progress, 0.1, 0.2), [&](std::int64_t first, std::int64_t last) {
+          for (std::int64_t e = first; e < last; ++e)
+          {
+            const double d = pr.Value[pr.A[e]] - pr.Value[pr.B[e]];
+            // Equal neighbours have weight 1 whatever sigma (a tiny sigma would give 0 * inf).
+            const double contact = pr.Contact.empty() ? 1.0 : pr.Contact[e];
+            computed[e] = contact * (d == 0.0 ? 1.0 : std::exp(-d * d * inv2s2));
+          }
+        }))
+    {
+      r.Aborted = true;
+      return r;
+    }
     for (std::int64_t e = 0; e < m; ++e)
     {
-      const double d = pr.Value[pr.A[e]] - pr.Value[pr.B[e]];
-      ss += d * d;
+      total += weight[e];
     }
-    r.Sigma = m ? std::sqrt(ss / static_cast<double>(m)) : 1.0;
-    if (!(r.Sigma > 0.0))
-    {
-      r.Sigma = 1.0;
-    }
-  }
-  const double inv2s2 = 1.0 / (2.0 * r.Sigma * r.Sigma);
-  if (phaseAborted(0.1))
-  {
-    return r;
-  }
-
-  // Not zero-filled: its pages are first touched in the loop below, which reports progress. The
-  // exponentials run on pr.Parallel; the sum stays in edge order (the same total for any split).
-  std::unique_ptr<double[]> weight(new double[m]);
-  if (!BatchedFor(m, 16384, pr.Parallel, SubProgress(progress, 0.1, 0.2), [&](std::int64_t first, std::int64_t last) {
-        for (std::int64_t e = first; e < last; ++e)
-        {
-          const double d = pr.Value[pr.A[e]] - pr.Value[pr.B[e]];
-          // Equal neighbours have weight 1 whatever sigma (a tiny sigma would give 0 * inf).
-          const double contact = pr.Contact.empty() ? 1.0 : pr.Contact[e];
-          weight[e] = contact * (d == 0.0 ? 1.0 : std::exp(-d * d * inv2s2));
-        }
-      }))
-  {
-    r.Aborted = true;
-    return r;
-  }
-  double total = 1.0;
-  for (std::int64_t e = 0; e < m; ++e)
-  {
-    total += weight[e];
   }
   if (phaseAborted(0.2))
   {
@@ -598,14 +619,11 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   // Terminal capacities (source = object: a node left on the source side pays its sink capacity).
   auto source = [&](std::int64_t p) { return pr.Hard[p] == 1 ? K : (pr.Hard[p] == 2 ? 0.0 : regionBackground[p]); };
   auto sink = [&](std::int64_t p) { return pr.Hard[p] == 2 ? K : (pr.Hard[p] == 1 ? 0.0 : regionObject[p]); };
-  // The kept flow applies when only terminal capacities changed: same edges, same weights.
-  std::shared_ptr<MaxFlowCache::Kept> kept = cache ? cache->State : nullptr;
+  // The kept flow applies when only terminal capacities changed: same graph, same weights.
   if (cache)
   {
     cache->State.reset(); // until this cut's flow has finished
   }
-  const bool reuse = kept && kept->A == pr.A && kept->B == pr.B && kept->Source.size() == static_cast<size_t>(n) &&
-    std::equal(kept->Weight.begin(), kept->Weight.end(), weight.get(), weight.get() + m);
   std::shared_ptr<Flow> g;
   try
   {
@@ -705,7 +723,12 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
       kept = std::make_shared<MaxFlowCache::Kept>();
       kept->A = pr.A;
       kept->B = pr.B;
-      kept->Weight.assign(weight.get(), weight.get() + m);
+      kept->Value = pr.Value;
+      kept->Contact = pr.Contact;
+      kept->SigmaParameter = par.Sigma;
+      kept->Sigma = r.Sigma;
+      kept->WeightTotal = total;
+      kept->Weight.assign(weight, weight + m);
     }
     kept->Graph = g;
     kept->Source.resize(n);

@@ -515,7 +515,8 @@ TEST(BoykovJolly, KeptCutsEqualFreshCuts)
   // 60 super-nodes of 1-40 noisy voxels each (spanning several bins), object-like first; a chain of
   // seed edits through one MaxFlowCache: a binning seen first (summed from the values), the same
   // binning again (kept as runs), read from the runs, a seed sample beyond the range (a new binning),
-  // and a parameter change. Each cut equals a fresh one: the same labels and flow.
+  // then a change of the bins and of sigma (new weights). Each cut equals a fresh one: the same
+  // labels and flow.
   std::mt19937 rng(11);
   std::normal_distribution<double> noise(0.0, 3.0);
   std::uniform_int_distribution<int> count(1, 40);
@@ -542,16 +543,14 @@ TEST(BoykovJolly, KeptCutsEqualFreshCuts)
   BoykovJollyParameters par;
   par.Lambda = 1.0;
   const std::vector<std::vector<double>> objectSamples = { { 20, 22, 18, 25 }, { 20, 22, 18, 25 }, { 21, 19, 23, 17 },
-    { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 } };
+    { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 } };
   MaxFlowCache cache;
   for (size_t edit = 0; edit < objectSamples.size(); ++edit)
   {
     pr.ObjectSamples = objectSamples[edit];
     pr.BackgroundSamples = { 5, 3, 7, 4 + static_cast<double>(edit) };
-    if (edit == 5)
-    {
-      par.Bins = 16;
-    }
+    par.Bins = edit >= 5 ? 16 : 0;
+    par.Sigma = edit >= 6 ? 2.0 : 0.0;
     const CutResult kept = BoykovJollyCut(pr, par, NoProgress(), &cache);
     const CutResult fresh = BoykovJollyCut(pr, par);
     ASSERT_TRUE(kept.Error.empty() && fresh.Error.empty()) << edit;
