@@ -123,7 +123,10 @@ public:
 
   // The worst AngleScore over the elements of a star, in frame coordinates, with vertex `moved` at
   // `at` (index space); -2 when an element is not positively oriented (exactly, in index space).
-  double StarQuality(const std::int64_t* star, std::int64_t n, std::int64_t moved, const V3& at) const
+  // Stops at the first element below `floor`, returning its score: callers that only ask whether
+  // the star reaches `floor` need not score the rest.
+  double StarQuality(const std::int64_t* star, std::int64_t n, std::int64_t moved, const V3& at,
+    double floor = -std::numeric_limits<double>::infinity()) const
   {
     const ImageGeometry& g = this->Topology.Geometry();
     double q = 1.0;
@@ -147,6 +150,10 @@ public:
         f[k] = &frame[k];
       }
       q = std::min(q, AngleScore(f, this->Vpc));
+      if (q < floor)
+      {
+        return q;
+      }
     }
     return q;
   }
@@ -214,7 +221,7 @@ public:
       {
         return false;
       }
-      const double after = this->StarQuality(star, n, vertex, to);
+      const double after = this->StarQuality(star, n, vertex, to, before);
       if (after > -2.0 && after >= before)
       {
         this->Points[vertex] = to;
@@ -338,7 +345,8 @@ std::int64_t DelaunayFlips(const ImageGeometry& g, const std::vector<V3>& indexP
 // its slivers' opposite faces (the directions that open a flat tetrahedron) and along the axes,
 // of 1/4, 1/8 and 1/16 of its shortest edge, and takes the one that most improves its star's worst
 // element. Vertices in id order, passes until none moves. Returns the moves made.
-std::int64_t PerturbSlivers(Smoother& s, double sliverAngle, int passes, const ProgressFunction& progress, bool& aborted)
+std::int64_t PerturbSlivers(Smoother& s, double sliverAngle, int passes, const ParallelFor& parallel, const ProgressFunction& progress,
+  bool& aborted)
 {
   const ImageGeometry& g = s.Topology.Geometry();
   const std::int64_t m = s.Topology.NumberOfElements();
@@ -353,17 +361,37 @@ std::int64_t PerturbSlivers(Smoother& s, double sliverAngle, int passes, const P
       v[k] = &frame[k];
     }
   };
+  // Sliver flags per element, kept current: only the stars of moved vertices change.
+  auto isSliver = [&](std::int64_t e) {
+    V3 frame[4];
+    const V3* v[4];
+    frameOf(e, frame, v);
+    return AngleScore(v, 4) < threshold;
+  };
+  std::vector<std::uint8_t> sliver(m);
+  parallel(m, 4096, [&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t c = b; c < e; ++c)
+    {
+      sliver[c] = isSliver(c) ? 1 : 0;
+    }
+  });
+  std::vector<std::int64_t> movedVertices;
   std::int64_t moved = 0;
   for (int pass = 0; pass < passes; ++pass)
   {
+    for (const std::int64_t vertex : movedVertices)
+    {
+      for (const std::int64_t* e = stars.Begin(vertex); e != stars.End(vertex); ++e)
+      {
+        sliver[*e] = isSliver(*e) ? 1 : 0;
+      }
+    }
+    movedVertices.clear();
     // Free vertices of slivers, in id order.
     std::vector<std::uint8_t> candidate(nPts, 0);
     for (std::int64_t e = 0; e < m; ++e)
     {
-      V3 frame[4];
-      const V3* v[4];
-      frameOf(e, frame, v);
-      if (AngleScore(v, 4) < threshold)
+      if (sliver[e])
       {
         for (int k = 0; k < 4; ++k)
         {
@@ -445,7 +473,8 @@ std::int64_t PerturbSlivers(Smoother& s, double sliverAngle, int passes, const P
           {
             continue;
           }
-          const double q = s.StarQuality(star, size, vertex, to);
+          // Only a star better than the best so far counts.
+          const double q = s.StarQuality(star, size, vertex, to, std::nextafter(best, 2.0));
           if (q > best)
           {
             best = q;
@@ -456,6 +485,7 @@ std::int64_t PerturbSlivers(Smoother& s, double sliverAngle, int passes, const P
       if (bestAt != from)
       {
         s.Points[vertex] = bestAt;
+        movedVertices.push_back(vertex);
         ++movedThisPass;
       }
     }
@@ -864,7 +894,7 @@ MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<s
   t0 = Clock::now();
   if (perturb)
   {
-    result.Perturbed = PerturbSlivers(s, p.SliverAngle, 10, SubProgress(progress, refine ? refineEnd : sweepShare, 1.0), result.Aborted);
+    result.Perturbed = PerturbSlivers(s, p.SliverAngle, 10, parallel, SubProgress(progress, refine ? refineEnd : sweepShare, 1.0), result.Aborted);
     if (result.Aborted)
     {
       return result;
