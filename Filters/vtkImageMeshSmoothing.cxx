@@ -158,6 +158,7 @@ int vtkImageMeshSmoothing::RequestData(
       return fail(result.Error);
     }
     const double smoothingSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    std::vector<float>().swap(floatStorage); // the statistics read the array in its own type
 
     t0 = Clock::now();
     const vtkSmartPointer<vtkIntArray> owner = NewVoxelOwnerArray(geometry.Size());

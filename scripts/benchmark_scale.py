@@ -4,7 +4,7 @@ and to 512^3, each run in a fresh process so that its peak memory is its own.
 usage: pvpython scripts/benchmark_scale.py [--case brain-tumour-brats-0005] [--sizes 1x,2x,512^3] [--out out/benchmark_scale]
 Each size runs stages 1 -> 2 -> 3 -> 4 at their defaults on the case's seeds (world points, so they
 hold on a resampled image) and reports each stage's seconds, the total, seconds per million voxels,
-the elements and the process's peak resident memory. The resampled images (linear interpolation,
+the elements and the process's peak resident memory after each stage (the last is the run's peak). The resampled images (linear interpolation,
 the same first and last voxel centres) are written to a temporary folder first. Writes OUT.md and OUT.csv.
 """
 import argparse
@@ -63,6 +63,8 @@ def child(folder, image):
         t = time.perf_counter()
         proxy.UpdatePipeline()
         row[key] = time.perf_counter() - t
+        # The process's peak so far: which stage sets it.
+        row[key[:-2] + "_peak_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0 ** 2
     row["elements"] = fm.fetch(cut, 0).GetNumberOfCells()
     row["peak_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0 ** 2
     print("RESULT " + json.dumps(row))
@@ -112,7 +114,7 @@ def main():
     finally:
         shutil.rmtree(work, ignore_errors=True)
     keys = ["size", "voxels", "elements", "nodes_s", "mesh_s", "smoothing_s", "cut_s", "total_s", "us_per_voxel",
-            "peak_gb", "bytes_per_voxel"]
+            "nodes_peak_gb", "mesh_peak_gb", "smoothing_peak_gb", "peak_gb", "bytes_per_voxel"]
     machine = report.machine()
     write_table(args.out, rows, keys, "Machine: %s; %s, one run per size, each in its own process." % (machine, args.case))
 

@@ -238,9 +238,12 @@ bool Usable(double v)
 std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progress, bool& aborted)
 {
   const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
-  const std::int64_t m = static_cast<std::int64_t>(pr.A.size());
+  const GraphEdges& edges = pr.Edges;
+  const std::int64_t m = edges.Size();
+  const auto& dims = edges.GridDims();
   if ((!pr.Size.empty() && static_cast<std::int64_t>(pr.Size.size()) != n) ||
-    static_cast<std::int64_t>(pr.Hard.size()) != n || static_cast<std::int64_t>(pr.B.size()) != m ||
+    static_cast<std::int64_t>(pr.Hard.size()) != n || edges.Malformed() ||
+    (edges.IsGrid() && static_cast<std::int64_t>(dims[0]) * dims[1] * dims[2] != n) ||
     (!pr.Contact.empty() && static_cast<std::int64_t>(pr.Contact.size()) != m) ||
     (pr.NodeVoxels && (static_cast<std::int64_t>(pr.NodeVoxels->Offset.size()) != n + 1 || pr.NodeVoxels->Empty())))
   {
@@ -255,17 +258,21 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
   {
     badSize += (std::isfinite(size) && size >= 0.0) ? 0 : 1;
   }
-  for (std::int64_t e = 0; e < m; ++e)
+  // Grid edges are valid by construction.
+  const std::int64_t blocks = edges.IsGrid() ? 0 : edges.Blocks();
+  for (std::int64_t k = 0; k < blocks; ++k)
   {
-    if ((e & CheckEvery) == CheckEvery && !progress(0.5 * static_cast<double>(e) / static_cast<double>(m)))
+    if ((k & 15) == 15 && !progress(0.5 * static_cast<double>(k) / static_cast<double>(blocks)))
     {
       aborted = true;
       return std::string();
     }
-    badEdge += (pr.A[e] >= 0 && pr.A[e] < n && pr.B[e] >= 0 && pr.B[e] < n &&
-                 (pr.Contact.empty() || (std::isfinite(pr.Contact[e]) && pr.Contact[e] >= 0.0)))
-      ? 0
-      : 1;
+    edges.ForEach(k, k + 1, [&](std::int64_t e, std::int64_t a, std::int64_t b) {
+      badEdge += (a >= 0 && a < n && b >= 0 && b < n &&
+                   (pr.Contact.empty() || (std::isfinite(pr.Contact[e]) && pr.Contact[e] >= 0.0)))
+        ? 0
+        : 1;
+    });
   }
   for (const auto* samples : { &pr.ObjectSamples, &pr.BackgroundSamples })
   {
@@ -296,8 +303,8 @@ using Flow = maxflow::Graph_DDD;
 struct MaxFlowCache::Kept
 {
   std::shared_ptr<Flow> Graph;
-  // The boundary term's inputs and what it made of them.
-  std::vector<std::int64_t> A, B;
+  // The boundary term's inputs (explicit edge lists copied) and what it made of them.
+  GraphEdges Edges;
   std::vector<double> Value, Contact;
   double SigmaParameter = 0.0, Sigma = 0.0, WeightTotal = 0.0;
   std::vector<double> Weight;
@@ -390,7 +397,8 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   CutResult r;
   const auto t0 = Clock::now();
   const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
-  const std::int64_t m = static_cast<std::int64_t>(pr.A.size());
+  const GraphEdges& edges = pr.Edges;
+  const std::int64_t m = edges.Size();
   if (n == 0)
   {
     r.Error = "the graph is empty.";
@@ -457,8 +465,8 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   // The boundary term depends on the graph alone: a kept flow of this very graph lends its weights
   // (and its residual graph, below).
   std::shared_ptr<MaxFlowCache::Kept> kept = cache ? cache->State : nullptr;
-  const bool reuse = kept && kept->SigmaParameter == par.Sigma && kept->A == pr.A && kept->B == pr.B &&
-    kept->Value == pr.Value && kept->Contact == pr.Contact;
+  const bool reuse = kept && kept->SigmaParameter == par.Sigma && kept->Edges.Same(edges) && kept->Value == pr.Value &&
+    kept->Contact == pr.Contact;
   std::unique_ptr<double[]> computed;
   const double* weight = nullptr;
   double total = 1.0;
@@ -474,11 +482,10 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     if (r.Sigma <= 0.0)
     {
       double ss = 0.0;
-      for (std::int64_t e = 0; e < m; ++e)
-      {
-        const double d = pr.Value[pr.A[e]] - pr.Value[pr.B[e]];
+      edges.ForEach([&](std::int64_t, std::int64_t a, std::int64_t b) {
+        const double d = pr.Value[a] - pr.Value[b];
         ss += d * d;
-      }
+      });
       r.Sigma = m ? std::sqrt(ss / static_cast<double>(m)) : 1.0;
       if (!(r.Sigma > 0.0))
       {
@@ -494,14 +501,13 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     // exponentials run on pr.Parallel; the sum stays in edge order (the same total for any split).
     computed.reset(new double[m]);
     weight = computed.get();
-    if (!BatchedFor(m, 16384, pr.Parallel, SubProgress(progress, 0.1, 0.2), [&](std::int64_t first, std::int64_t last) {
-          for (std::int64_t e = first; e < last; ++e)
-          {
-            const double d = pr.Value[pr.A[e]] - pr.Value[pr.B[e]];
+    if (!BatchedFor(edges.Blocks(), 1, pr.Parallel, SubProgress(progress, 0.1, 0.2), [&](std::int64_t first, std::int64_t last) {
+          edges.ForEach(first, last, [&](std::int64_t e, std::int64_t a, std::int64_t b) {
+            const double d = pr.Value[a] - pr.Value[b];
             // Equal neighbours have weight 1 whatever sigma (a tiny sigma would give 0 * inf).
             const double contact = pr.Contact.empty() ? 1.0 : pr.Contact[e];
             computed[e] = contact * (d == 0.0 ? 1.0 : std::exp(-d * d * inv2s2));
-          }
+          });
         }))
     {
       r.Aborted = true;
@@ -669,10 +675,13 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
         }
         g->add_tweights(static_cast<int>(p), source(p), sink(p));
       }
-      for (std::int64_t e = 0; e < m; ++e)
+      const std::int64_t blocks = edges.Blocks();
+      for (std::int64_t k = 0; k < blocks; ++k)
       {
-        g->add_edge(static_cast<int>(pr.A[e]), static_cast<int>(pr.B[e]), weight[e], weight[e]);
-        if (aborted(e, m, 0.45, 0.5))
+        edges.ForEach(k, k + 1, [&](std::int64_t e, std::int64_t a, std::int64_t b) {
+          g->add_edge(static_cast<int>(a), static_cast<int>(b), weight[e], weight[e]);
+        });
+        if ((k & 15) == 15 && phaseAborted(0.45 + 0.05 * static_cast<double>(k) / static_cast<double>(blocks)))
         {
           return r;
         }
@@ -721,8 +730,9 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     if (!reuse)
     {
       kept = std::make_shared<MaxFlowCache::Kept>();
-      kept->A = pr.A;
-      kept->B = pr.B;
+      kept->Edges = edges.IsGrid() ? edges
+                                   : GraphEdges::Owned(std::vector<std::int64_t>(edges.First(), edges.First() + m),
+                                       std::vector<std::int64_t>(edges.Second(), edges.Second() + m));
       kept->Value = pr.Value;
       kept->Contact = pr.Contact;
       kept->SigmaParameter = par.Sigma;

@@ -21,33 +21,35 @@ std::int64_t Find(std::vector<std::int64_t>& parent, std::int64_t p)
 }
 } // namespace
 
-std::vector<std::int64_t> LabelComponents(const std::vector<std::uint8_t>& label, const std::vector<std::int64_t>& A,
-  const std::vector<std::int64_t>& B, std::int64_t& count, const ProgressFunction& progress)
+std::vector<std::int64_t> LabelComponents(
+  const std::vector<std::uint8_t>& label, const GraphEdges& edges, std::int64_t& count, const ProgressFunction& progress)
 {
   const std::int64_t n = static_cast<std::int64_t>(label.size());
   std::vector<std::int64_t> parent;
   AssignFresh(parent, static_cast<std::size_t>(n));
   std::iota(parent.begin(), parent.end(), std::int64_t(0));
-  constexpr std::size_t CheckEvery = (std::size_t(1) << 18) - 1;
-  for (std::size_t e = 0; e < A.size(); ++e)
+  const std::int64_t blocks = edges.Blocks();
+  for (std::int64_t k = 0; k < blocks; ++k)
   {
-    if ((e & CheckEvery) == CheckEvery && !progress(0.9 * static_cast<double>(e) / static_cast<double>(A.size())))
+    if ((k & 15) == 15 && !progress(0.9 * static_cast<double>(k) / static_cast<double>(blocks)))
     {
       return {};
     }
-    if (label[A[e]] == label[B[e]])
-    {
-      std::int64_t a = Find(parent, A[e]), b = Find(parent, B[e]);
-      if (a != b)
+    edges.ForEach(k, k + 1, [&](std::int64_t, std::int64_t p, std::int64_t q) {
+      if (label[p] == label[q])
       {
-        // The smaller root wins, so a component's root is its first node whatever the edge order.
-        if (b < a)
+        std::int64_t a = Find(parent, p), b = Find(parent, q);
+        if (a != b)
         {
-          std::swap(a, b);
+          // The smaller root wins, so a component's root is its first node whatever the edge order.
+          if (b < a)
+          {
+            std::swap(a, b);
+          }
+          parent[b] = a;
         }
-        parent[b] = a;
       }
-    }
+    });
   }
   for (std::int64_t p = 0; p < n; ++p)
   {
@@ -62,8 +64,8 @@ std::vector<std::int64_t> LabelComponents(const std::vector<std::uint8_t>& label
   return parent;
 }
 
-std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label,
-  const std::vector<std::int64_t>& A, const std::vector<std::int64_t>& B, const std::vector<std::uint8_t>& hard,
+std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label, const GraphEdges& edges,
+  const std::vector<std::uint8_t>& hard,
   const std::vector<std::uint8_t>& border, const ProgressFunction& progress, std::vector<double>* objectSizes,
   const std::vector<double>& size)
 {
@@ -75,7 +77,7 @@ std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& lab
   // whole components, over the (few) edges between labels.
   const std::int64_t n = static_cast<std::int64_t>(label.size());
   std::int64_t count = 0;
-  const std::vector<std::int64_t> id = LabelComponents(label, A, B, count, SubProgress(progress, 0.0, 0.8));
+  const std::vector<std::int64_t> id = LabelComponents(label, edges, count, SubProgress(progress, 0.0, 0.8));
   if (static_cast<std::int64_t>(id.size()) != n)
   {
     return -1;
@@ -98,14 +100,13 @@ std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& lab
   }
   // Components meeting across an edge: always of different labels.
   std::vector<std::pair<std::int64_t, std::int64_t>> meet;
-  for (std::size_t e = 0; e < A.size(); ++e)
-  {
-    const std::int64_t a = id[A[e]], b = id[B[e]];
+  edges.ForEach([&](std::int64_t, std::int64_t p, std::int64_t q) {
+    const std::int64_t a = id[p], b = id[q];
     if (a != b)
     {
       meet.emplace_back(std::min(a, b), std::max(a, b));
     }
-  }
+  });
   std::sort(meet.begin(), meet.end());
   meet.erase(std::unique(meet.begin(), meet.end()), meet.end());
   if (!progress(0.9))
@@ -192,12 +193,12 @@ std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& lab
   return progress(1.0) ? changed : -1;
 }
 
-std::vector<double> ObjectComponentSizes(const std::vector<std::uint8_t>& label, const std::vector<std::int64_t>& A,
-  const std::vector<std::int64_t>& B, const std::vector<double>& size, const ProgressFunction& progress)
+std::vector<double> ObjectComponentSizes(
+  const std::vector<std::uint8_t>& label, const GraphEdges& edges, const std::vector<double>& size, const ProgressFunction& progress)
 {
   std::vector<std::uint8_t> unchanged(label);
   std::vector<double> sizes;
-  return ApplyConnectivity(Connectivity::Off, unchanged, A, B, {}, {}, progress, &sizes, size) < 0 ? std::vector<double>() : sizes;
+  return ApplyConnectivity(Connectivity::Off, unchanged, edges, {}, {}, progress, &sizes, size) < 0 ? std::vector<double>() : sizes;
 }
 
 } // namespace featuremesh

@@ -2,6 +2,7 @@
 // voxels sharing a face) and the connectivity rule applied after either cut.
 #pragma once
 
+#include "GraphEdges.h"
 #include "Parallel.h"
 
 #include <cstdint>
@@ -22,11 +23,10 @@ enum class Connectivity : int
   SeededObject = 2,
 };
 
-// Components of equal label over the edges A[i]-B[i]: an id per node, numbered in order of each
+// Components of equal label over the graph's edges: an id per node, numbered in order of each
 // component's first node (deterministic); `count` receives their number. Empty when `progress`
 // (asked every 2^18 edges: a voxel graph has tens of millions) aborts.
-std::vector<std::int64_t> LabelComponents(
-  const std::vector<std::uint8_t>& label, const std::vector<std::int64_t>& A, const std::vector<std::int64_t>& B,
+std::vector<std::int64_t> LabelComponents(const std::vector<std::uint8_t>& label, const GraphEdges& edges,
   std::int64_t& count, const ProgressFunction& progress = NoProgress());
 
 // Applies `mode` to `label` (1 object, 0 background) in place; `hard` (0 free, 1 object seed, 2
@@ -34,13 +34,13 @@ std::vector<std::int64_t> LabelComponents(
 // label. Returns how many node relabellings it made (a node the seeded rule drops and hole filling
 // takes back counts twice), or -1 when `progress` aborts. `objectSizes` (optional) receives the
 // sizes of the resulting object components as ObjectComponentSizes gives them, from the same pass.
-std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label,
-  const std::vector<std::int64_t>& A, const std::vector<std::int64_t>& B, const std::vector<std::uint8_t>& hard,
+std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label, const GraphEdges& edges,
+  const std::vector<std::uint8_t>& hard,
   const std::vector<std::uint8_t>& border, const ProgressFunction& progress = NoProgress(),
   std::vector<double>* objectSizes = nullptr, const std::vector<double>& size = {});
 
 // The sizes of the object components (sum of `size` over their nodes, 1 per node when `size` is
 // empty), largest first; empty when `progress` aborts.
-std::vector<double> ObjectComponentSizes(const std::vector<std::uint8_t>& label, const std::vector<std::int64_t>& A,
-  const std::vector<std::int64_t>& B, const std::vector<double>& size, const ProgressFunction& progress = NoProgress());
+std::vector<double> ObjectComponentSizes(const std::vector<std::uint8_t>& label, const GraphEdges& edges,
+  const std::vector<double>& size, const ProgressFunction& progress = NoProgress());
 } // namespace featuremesh

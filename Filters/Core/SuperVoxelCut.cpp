@@ -115,8 +115,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   pr.Size = voxelCount;
   pr.Parallel = parallel;
   const FaceAdjacency& adj = mesh.Faces();
-  pr.A = adj.A;
-  pr.B = adj.B;
+  pr.Edges = GraphEdges(adj.A, adj.B);
   pr.Contact = ContactInVoxelFaces(mesh, parameters.ScaleByContact);
   // Seed histograms: the voxels of the seed elements when the values are there, else their means
   // weighted by their voxel counts.
@@ -168,7 +167,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   {
     border[e] = 1;
   }
-  result.Cut.ConnectivityChanged = ApplyConnectivity(parameters.Connectivity, result.Cut.Label, adj.A, adj.B, pr.Hard,
+  result.Cut.ConnectivityChanged = ApplyConnectivity(parameters.Connectivity, result.Cut.Label, pr.Edges, pr.Hard,
     border, NoProgress(), &result.Cut.ObjectComponentVoxels, voxelCount);
   result.BoundaryFaces = LabelBoundaryFaces(mesh, result.Cut.Label);
   return result;
@@ -220,39 +219,13 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
   const VoxelValueFunction value = [&pr](std::int64_t v) { return pr.Value[v]; };
   SeedNeighbourhoodSamples(value, g, objectVoxels, parameters.SeedRadius, pr.ObjectSamples);
   SeedNeighbourhoodSamples(value, g, backgroundVoxels, parameters.SeedRadius, pr.BackgroundSamples);
-  const std::int64_t sx = 1, sy = g.Dims[0], sz = g.SliceStride();
-  const std::int64_t edges = (g.Dims[0] - 1) * std::int64_t(g.Dims[1]) * g.Dims[2] +
-    std::int64_t(g.Dims[0]) * (g.Dims[1] - 1) * g.Dims[2] + (g.Is2D() ? 0 : sz * (g.Dims[2] - 1));
-  pr.A.reserve(edges);
-  pr.B.reserve(edges);
-  for (int k = 0; k < g.Dims[2]; ++k)
+  if (!progress(0.1))
   {
-    if (!progress(0.1 * k / g.Dims[2]))
-    {
-      failed.Aborted = true;
-      return failed;
-    }
-    for (int j = 0; j < g.Dims[1]; ++j)
-      for (int i = 0; i < g.Dims[0]; ++i)
-      {
-        const std::int64_t v = g.Index(i, j, k);
-        if (i + 1 < g.Dims[0])
-        {
-          pr.A.push_back(v);
-          pr.B.push_back(v + sx);
-        }
-        if (j + 1 < g.Dims[1])
-        {
-          pr.A.push_back(v);
-          pr.B.push_back(v + sy);
-        }
-        if (k + 1 < g.Dims[2])
-        {
-          pr.A.push_back(v);
-          pr.B.push_back(v + sz);
-        }
-      }
+    failed.Aborted = true;
+    return failed;
   }
+  // Voxels sharing a face: enumerated, not stored.
+  pr.Edges = GraphEdges::Grid(g.Dims[0], g.Dims[1], g.Dims[2]);
   // Size and Contact stay empty: 1 for every voxel and every voxel face.
   CutResult cut = BoykovJollyCut(pr, parameters, SubProgress(progress, 0.1, 0.95));
   if (!cut.Error.empty() || cut.Aborted || !progress(0.95))
@@ -268,7 +241,7 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
         border[g.Index(i, j, k)] = i == 0 || j == 0 || i + 1 == g.Dims[0] || j + 1 == g.Dims[1] ||
           (!g.Is2D() && (k == 0 || k + 1 == g.Dims[2]));
       }
-  cut.ConnectivityChanged = ApplyConnectivity(parameters.Connectivity, cut.Label, pr.A, pr.B, pr.Hard, border,
+  cut.ConnectivityChanged = ApplyConnectivity(parameters.Connectivity, cut.Label, pr.Edges, pr.Hard, border,
     SubProgress(progress, 0.95, 1.0), &cut.ObjectComponentVoxels);
   if (cut.ConnectivityChanged < 0)
   {

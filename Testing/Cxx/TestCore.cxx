@@ -425,6 +425,7 @@ CutProblem SeededChain(const std::vector<double>& values)
 {
   CutProblem pr;
   const std::int64_t n = static_cast<std::int64_t>(values.size());
+  std::vector<std::int64_t> A, B;
   for (std::int64_t i = 0; i < n; ++i)
   {
     pr.Value.push_back(values[i]);
@@ -432,11 +433,12 @@ CutProblem SeededChain(const std::vector<double>& values)
     pr.Hard.push_back(i == 0 ? 1 : (i == n - 1 ? 2 : 0));
     if (i > 0)
     {
-      pr.A.push_back(i - 1);
-      pr.B.push_back(i);
+      A.push_back(i - 1);
+      B.push_back(i);
       pr.Contact.push_back(1.0);
     }
   }
+  pr.Edges = GraphEdges::Owned(std::move(A), std::move(B));
   return pr;
 }
 
@@ -489,8 +491,7 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   two.Value = { 10.0, 0.0, 7.5 };
   two.Size = { 1.0, 1.0, 4.0 };
   two.Hard = { 1, 2, 0 };
-  two.A = { 0, 1 };
-  two.B = { 2, 2 };
+  two.Edges = GraphEdges::Owned({ 0, 1 }, { 2, 2 });
   two.Contact = { 0.01, 0.01 };
   const std::vector<double> v = { 10.0, 0.0, 10.0, 10.0, 10.0, 0.0 };
   const std::vector<std::int32_t> o = { 0, 1, 2, 2, 2, 2 };
@@ -1086,7 +1087,13 @@ TEST(Guards, EnergyInputsAreCheckedAndSeedsAlwaysHold)
   bad.Contact[0] = std::numeric_limits<double>::infinity();
   EXPECT_FALSE(BoykovJollyCut(bad, BoykovJollyParameters()).Error.empty());
   bad = pr;
-  bad.B[0] = 99;
+  std::vector<std::int64_t> A(pr.Edges.First(), pr.Edges.First() + pr.Edges.Size());
+  std::vector<std::int64_t> B(pr.Edges.Second(), pr.Edges.Second() + pr.Edges.Size());
+  B[0] = 99;
+  bad.Edges = GraphEdges::Owned(A, B);
+  EXPECT_FALSE(BoykovJollyCut(bad, BoykovJollyParameters()).Error.empty());
+  B.pop_back();
+  bad.Edges = GraphEdges(A, B);
   EXPECT_FALSE(BoykovJollyCut(bad, BoykovJollyParameters()).Error.empty());
   BoykovJollyParameters huge;
   huge.Lambda = 1e300;
@@ -1173,16 +1180,60 @@ TEST(Delaunay, QualityRefinementRaisesTheMinimumDihedralAngle)
   EXPECT_GT(after, 5.0);
 }
 
+TEST(GraphEdges, GridEdgesAreTheFaceNeighboursInVoxelOrderAndBlocksSplitThem)
+{
+  for (const std::array<int, 3>& d : std::vector<std::array<int, 3>>{
+         { { 5, 4, 3 } }, { { 7, 6, 1 } }, { { 1, 3, 4 } }, { { 2, 1, 1 } }, { { 6000, 3, 2 } }, { { 3, 2000, 3 } } })
+  {
+    // The list the voxel cut used to store: each voxel in raster order with its +x, +y, +z neighbour.
+    std::vector<std::int64_t> A, B;
+    const std::int64_t sy = d[0], sz = static_cast<std::int64_t>(d[0]) * d[1];
+    for (int k = 0; k < d[2]; ++k)
+      for (int j = 0; j < d[1]; ++j)
+        for (int i = 0; i < d[0]; ++i)
+        {
+          const std::int64_t v = i + sy * j + sz * k;
+          for (const auto& step : { std::make_pair(i + 1 < d[0], std::int64_t(1)), std::make_pair(j + 1 < d[1], sy),
+                 std::make_pair(k + 1 < d[2], sz) })
+          {
+            if (step.first)
+            {
+              A.push_back(v);
+              B.push_back(v + step.second);
+            }
+          }
+        }
+    const GraphEdges grid = GraphEdges::Grid(d[0], d[1], d[2]);
+    ASSERT_EQ(grid.Size(), static_cast<std::int64_t>(A.size())) << d[0] << " " << d[1] << " " << d[2];
+    std::int64_t seen = 0;
+    for (std::int64_t k = 0; k < grid.Blocks(); ++k)
+    {
+      EXPECT_EQ(grid.BlockStart(k), seen);
+      grid.ForEach(k, k + 1, [&](std::int64_t e, std::int64_t a, std::int64_t b) {
+        EXPECT_EQ(e, seen);
+        EXPECT_EQ(a, A[e]);
+        EXPECT_EQ(b, B[e]);
+        ++seen;
+      });
+    }
+    EXPECT_EQ(seen, grid.Size());
+    EXPECT_EQ(grid.BlockStart(grid.Blocks()), grid.Size());
+    EXPECT_TRUE(grid.Same(GraphEdges::Grid(d[0], d[1], d[2])));
+    EXPECT_FALSE(grid.Same(GraphEdges(A, B)));
+    EXPECT_TRUE(GraphEdges(A, B).Same(GraphEdges::Owned(A, B)));
+  }
+}
+
 TEST(SeedConnectivity, ComponentsAreNumberedInNodeOrder)
 {
   // A chain 0-1-2-3-4-5 with labels 1 1 0 1 0 0, edges listed backwards.
   const std::vector<std::uint8_t> label = { 1, 1, 0, 1, 0, 0 };
   const std::vector<std::int64_t> A = { 4, 3, 2, 1, 0 }, B = { 5, 4, 3, 2, 1 };
   std::int64_t count = 0;
-  const std::vector<std::int64_t> id = LabelComponents(label, A, B, count);
+  const std::vector<std::int64_t> id = LabelComponents(label, GraphEdges(A, B), count);
   EXPECT_EQ(count, 4);
   EXPECT_EQ(id, (std::vector<std::int64_t>{ 0, 0, 1, 2, 3, 3 }));
-  EXPECT_EQ(ObjectComponentSizes(label, A, B, { 1, 2, 4, 8, 16, 32 }), (std::vector<double>{ 8, 3 }));
+  EXPECT_EQ(ObjectComponentSizes(label, GraphEdges(A, B), { 1, 2, 4, 8, 16, 32 }), (std::vector<double>{ 8, 3 }));
 }
 
 TEST(SeedConnectivity, VoxelCutKeepsWhatTheSeedsReachAndFillsHoles)
