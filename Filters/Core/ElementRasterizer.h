@@ -37,6 +37,11 @@ public:
   template <typename Visitor>
   void ForEachVoxel(std::int64_t e, Visitor&& visit) const;
 
+  // The elements in Morton order of their lowest voxel corner (4-voxel blocks): a pass over them
+  // in this order reads and writes neighbouring voxels, where mesher order jumps across the image
+  // and waits on memory. What a pass gives each element does not depend on the order.
+  const std::vector<std::int64_t>& SpatialOrder() const { return this->Order; }
+
 private:
   // A face: its plane (n, d) with the element on the positive side, and, for elements with a node
   // off the voxel lattice, its vertices in ascending id order and the sign that orients them.
@@ -57,6 +62,7 @@ private:
   double TwiceCentre[3];
   // Lattice elements' row bounds are exact (every dimension below 4096 voxels).
   bool ExactBounds = false;
+  std::vector<std::int64_t> Order;
 };
 
 // Voxel value statistics per element: exact over owned centres; elements owning none take the
