@@ -310,73 +310,50 @@ const CompressedRows& SimplexMesh::VertexNeighbours() const
   return *this->Cached->Neighbours;
 }
 
-std::vector<std::int64_t> LabelBoundaryFaces(
-  const SimplexMesh& mesh, const std::vector<std::uint8_t>& label, std::int64_t* interfaceFaces)
+namespace
 {
-  // The faces of the object elements that no other object element shares: hashing the object's
-  // faces needs no adjacency of the whole mesh.
-  const int vpc = mesh.VerticesPerCell();
-  struct Face
-  {
-    std::array<std::int64_t, 3> Key;
-    std::int64_t Element;
-    int Local;
-  };
-  std::vector<Face> faces;
-  for (std::int64_t e = 0; e < mesh.NumberOfElements(); ++e)
-  {
-    if (!label[e])
-    {
-      continue;
-    }
-    const std::int64_t* cell = mesh.Cell(e);
-    for (int f = 0; f < vpc; ++f)
-    {
-      Face face{ { { -1, -1, -1 } }, e, f };
-      for (int k = 1, n = 0; k < vpc; ++k)
-      {
-        face.Key[n++] = cell[(f + k) % vpc];
-      }
-      std::sort(face.Key.begin(), face.Key.begin() + vpc - 1);
-      faces.push_back(face);
-    }
-  }
-  std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.Key < b.Key; });
-  // A face on the image box lies in one box plane: every vertex has the same extreme index on one axis.
+// A face whose vertices all lie in one plane of the image box.
+bool OnBox(const SimplexMesh& mesh, const std::int64_t* ids, int count)
+{
   const ImageGeometry& g = mesh.Geometry();
   const auto& P = mesh.Points();
-  auto onBox = [&](const Face& face) {
-    for (int a = 0; a < g.Dimension(); ++a)
+  for (int a = 0; a < g.Dimension(); ++a)
+  {
+    for (const double side : { 0.0, g.Dims[a] - 1.0 })
     {
-      for (const double side : { 0.0, g.Dims[a] - 1.0 })
+      bool all = true;
+      for (int k = 0; all && k < count; ++k)
       {
-        bool all = true;
-        for (int k = 0; all && k < vpc - 1; ++k)
-        {
-          all = P[face.Key[k]][a] == side;
-        }
-        if (all)
-        {
-          return true;
-        }
+        all = P[ids[k]][a] == side;
+      }
+      if (all)
+      {
+        return true;
       }
     }
-    return false;
-  };
-  std::vector<std::pair<std::int64_t, int>> inner, hull;
-  for (std::size_t i = 0; i < faces.size();)
-  {
-    std::size_t j = i + 1;
-    while (j < faces.size() && faces[j].Key == faces[i].Key)
-    {
-      ++j;
-    }
-    if (j == i + 1)
-    {
-      (onBox(faces[i]) ? hull : inner).emplace_back(faces[i].Element, faces[i].Local);
-    }
-    i = j;
   }
+  return false;
+}
+
+// The ids of local face f (opposite local vertex f) of element e, ascending.
+std::array<std::int64_t, 3> FaceKey(const SimplexMesh& mesh, std::int64_t e, int f)
+{
+  const int vpc = mesh.VerticesPerCell();
+  const std::int64_t* cell = mesh.Cell(e);
+  std::array<std::int64_t, 3> key = { { -1, -1, -1 } };
+  for (int k = 1, n = 0; k < vpc; ++k)
+  {
+    key[n++] = cell[(f + k) % vpc];
+  }
+  std::sort(key.begin(), key.begin() + vpc - 1);
+  return key;
+}
+
+// The boundary's (element, local face) pairs, interface and hull, as oriented faces in their order.
+std::vector<std::int64_t> OrientedBoundary(const SimplexMesh& mesh, std::vector<std::pair<std::int64_t, int>>& inner,
+  std::vector<std::pair<std::int64_t, int>>& hull, std::int64_t* interfaceFaces)
+{
+  const int vpc = mesh.VerticesPerCell();
   std::sort(inner.begin(), inner.end());
   std::sort(hull.begin(), hull.end());
   if (interfaceFaces)
@@ -401,5 +378,74 @@ std::vector<std::int64_t> LabelBoundaryFaces(
     }
   }
   return out;
+}
+} // namespace
+
+std::vector<std::int64_t> LabelBoundaryFaces(
+  const SimplexMesh& mesh, const std::vector<std::uint8_t>& label, std::int64_t* interfaceFaces)
+{
+  // The faces of the object elements that no other object element shares: hashing the object's
+  // faces needs no adjacency of the whole mesh.
+  const int vpc = mesh.VerticesPerCell();
+  struct Face
+  {
+    std::array<std::int64_t, 3> Key;
+    std::int64_t Element;
+    int Local;
+  };
+  std::vector<Face> faces;
+  for (std::int64_t e = 0; e < mesh.NumberOfElements(); ++e)
+  {
+    if (!label[e])
+    {
+      continue;
+    }
+    for (int f = 0; f < vpc; ++f)
+    {
+      faces.push_back(Face{ FaceKey(mesh, e, f), e, f });
+    }
+  }
+  std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.Key < b.Key; });
+  std::vector<std::pair<std::int64_t, int>> inner, hull;
+  for (std::size_t i = 0; i < faces.size();)
+  {
+    std::size_t j = i + 1;
+    while (j < faces.size() && faces[j].Key == faces[i].Key)
+    {
+      ++j;
+    }
+    if (j == i + 1)
+    {
+      (OnBox(mesh, faces[i].Key.data(), vpc - 1) ? hull : inner).emplace_back(faces[i].Element, faces[i].Local);
+    }
+    i = j;
+  }
+  return OrientedBoundary(mesh, inner, hull, interfaceFaces);
+}
+
+std::vector<std::int64_t> LabelBoundaryFaces(const SimplexMesh& mesh, const FaceAdjacency& adjacency,
+  const std::vector<std::uint8_t>& label, std::int64_t* interfaceFaces)
+{
+  std::vector<std::pair<std::int64_t, int>> inner, hull;
+  for (std::size_t i = 0; i < adjacency.A.size(); ++i)
+  {
+    const std::int64_t a = adjacency.A[i], b = adjacency.B[i];
+    if (label[a] != label[b])
+    {
+      inner.emplace_back(label[a] ? a : b, label[a] ? adjacency.LocalA[i] : adjacency.LocalB[i]);
+    }
+  }
+  const int vpc = mesh.VerticesPerCell();
+  for (std::size_t h = 0; h < adjacency.HullElement.size(); ++h)
+  {
+    const std::int64_t e = adjacency.HullElement[h];
+    if (label[e])
+    {
+      // Unshared faces off the box (a mesh that does not tile it) count as interface, as above.
+      const std::array<std::int64_t, 3> key = FaceKey(mesh, e, adjacency.HullFace[h]);
+      (OnBox(mesh, key.data(), vpc - 1) ? hull : inner).emplace_back(e, adjacency.HullFace[h]);
+    }
+  }
+  return OrientedBoundary(mesh, inner, hull, interfaceFaces);
 }
 } // namespace featuremesh

@@ -99,4 +99,7 @@ void OutwardFace(const std::vector<std::array<double, 3>>& points, const std::in
 // `interfaceFaces` receives the number of interface faces. Needs no face adjacency.
 std::vector<std::int64_t> LabelBoundaryFaces(
   const SimplexMesh& mesh, const std::vector<std::uint8_t>& label, std::int64_t* interfaceFaces = nullptr);
+// The same from the mesh's face adjacency (Faces()), for callers that hold it: no hashing.
+std::vector<std::int64_t> LabelBoundaryFaces(const SimplexMesh& mesh, const FaceAdjacency& adjacency,
+  const std::vector<std::uint8_t>& label, std::int64_t* interfaceFaces = nullptr);
 } // namespace featuremesh

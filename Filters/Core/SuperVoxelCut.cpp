@@ -169,7 +169,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   }
   result.Cut.ConnectivityChanged = ApplyConnectivity(parameters.Connectivity, result.Cut.Label, pr.Edges, pr.Hard,
     border, NoProgress(), &result.Cut.ObjectComponentVoxels, voxelCount);
-  result.BoundaryFaces = LabelBoundaryFaces(mesh, result.Cut.Label);
+  result.BoundaryFaces = LabelBoundaryFaces(mesh, adj, result.Cut.Label);
   return result;
 }
 

@@ -725,6 +725,12 @@ TEST(SimplexMesh, LabelBoundaryIsClosedAndOutward)
     const SimplexMesh m(h, mesh.Points(), mesh.Cells(), 4);
     const std::vector<std::int64_t> faces = LabelBoundaryFaces(m, label);
     ASSERT_EQ(faces.size() % 3, 0u);
+    // The cut's path, from the face adjacency, gives the same faces in the same order.
+    std::int64_t hashedInterface = -1, adjacentInterface = -2;
+    LabelBoundaryFaces(m, label, &hashedInterface);
+    EXPECT_EQ(LabelBoundaryFaces(m, m.Faces(), label, &adjacentInterface), faces);
+    EXPECT_EQ(adjacentInterface, hashedInterface);
+    EXPECT_GT(hashedInterface, 0);
     std::map<std::pair<std::int64_t, std::int64_t>, int> edges;
     double enclosed = 0.0;
     const std::vector<std::array<double, 3>> world = m.WorldPoints();
