@@ -307,7 +307,7 @@ struct MaxFlowCache::Kept
   GraphEdges Edges;
   std::vector<double> Value, Contact;
   double SigmaParameter = 0.0, Sigma = 0.0, WeightTotal = 0.0;
-  std::vector<double> Weight;
+  std::unique_ptr<double[]> Weight; // one per edge
   // The terminal capacities of the last flow.
   std::vector<double> Source, Sink;
 };
@@ -473,7 +473,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   if (reuse)
   {
     r.Sigma = kept->Sigma;
-    weight = kept->Weight.data();
+    weight = kept->Weight.get();
     total = kept->WeightTotal;
   }
   else
@@ -730,15 +730,17 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     if (!reuse)
     {
       kept = std::make_shared<MaxFlowCache::Kept>();
-      kept->Edges = edges.IsGrid() ? edges
-                                   : GraphEdges::Owned(std::vector<std::int64_t>(edges.First(), edges.First() + m),
-                                       std::vector<std::int64_t>(edges.Second(), edges.Second() + m));
+      // Held lists and the weights are kept as they are; lists only viewed are copied.
+      kept->Edges = edges.IsGrid() || edges.Held()
+        ? edges
+        : GraphEdges::Owned(std::vector<std::int64_t>(edges.First(), edges.First() + m),
+            std::vector<std::int64_t>(edges.Second(), edges.Second() + m));
       kept->Value = pr.Value;
       kept->Contact = pr.Contact;
       kept->SigmaParameter = par.Sigma;
       kept->Sigma = r.Sigma;
       kept->WeightTotal = total;
-      kept->Weight.assign(weight, weight + m);
+      kept->Weight = std::move(computed);
     }
     kept->Graph = g;
     kept->Source.resize(n);

@@ -28,6 +28,13 @@ public:
     , Mismatch(a.size() != b.size())
   {
   }
+  // A view of immutable lists that `keep` holds: copies of this GraphEdges keep them alive, and two
+  // views with the same holder compare equal without reading the lists.
+  GraphEdges(const std::vector<std::int64_t>& a, const std::vector<std::int64_t>& b, std::shared_ptr<const void> keep)
+    : GraphEdges(a, b)
+  {
+    this->Keep = std::move(keep);
+  }
   // Lists the edges own: copies of this GraphEdges share them.
   static GraphEdges Owned(std::vector<std::int64_t> a, std::vector<std::int64_t> b)
   {
@@ -57,12 +64,18 @@ public:
   const std::int64_t* First() const { return this->A; }
   const std::int64_t* Second() const { return this->B; }
 
+  // Lists that a holder keeps unchanged (owned, or held): safe to keep instead of copying.
+  bool Held() const { return this->Keep != nullptr; }
   // The same edges in the same order.
   bool Same(const GraphEdges& o) const
   {
     if (this->IsGrid() || o.IsGrid())
     {
       return this->Dims == o.Dims;
+    }
+    if (this->Keep && this->Keep == o.Keep && this->A == o.A && this->B == o.B && this->M == o.M)
+    {
+      return true;
     }
     return this->M == o.M && std::equal(this->A, this->A + this->M, o.A) && std::equal(this->B, this->B + this->M, o.B);
   }

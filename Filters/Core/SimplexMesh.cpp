@@ -252,6 +252,13 @@ const FaceAdjacency& SimplexMesh::Faces() const
   return *this->Cached->Faces;
 }
 
+std::shared_ptr<const FaceAdjacency> SimplexMesh::SharedFaces() const
+{
+  this->Faces();
+  std::lock_guard<std::mutex> lock(this->Cached->Lock);
+  return this->Cached->Faces;
+}
+
 const CompressedRows& SimplexMesh::Stars() const
 {
   std::lock_guard<std::mutex> lock(this->Cached->Lock);

@@ -67,6 +67,8 @@ public:
 
   // Built on first use, then cached; safe to call from several threads.
   const FaceAdjacency& Faces() const;
+  // The same adjacency, shared: it stays alive (unchanged) as long as a holder keeps it.
+  std::shared_ptr<const FaceAdjacency> SharedFaces() const;
   const CompressedRows& Stars() const;
   const CompressedRows& VertexNeighbours() const;
 

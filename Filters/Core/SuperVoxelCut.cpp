@@ -114,8 +114,10 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   pr.Value = mean;
   pr.Size = voxelCount;
   pr.Parallel = parallel;
-  const FaceAdjacency& adj = mesh.Faces();
-  pr.Edges = GraphEdges(adj.A, adj.B);
+  // Shared with the mesh: a kept flow holds the same lists instead of a copy.
+  const std::shared_ptr<const FaceAdjacency> faces = mesh.SharedFaces();
+  const FaceAdjacency& adj = *faces;
+  pr.Edges = GraphEdges(adj.A, adj.B, faces);
   pr.Contact = ContactInVoxelFaces(mesh, parameters.ScaleByContact);
   // Seed histograms: the voxels of the seed elements when the values are there, else their means
   // weighted by their voxel counts.

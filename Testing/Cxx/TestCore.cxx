@@ -544,10 +544,19 @@ TEST(BoykovJolly, KeptCutsEqualFreshCuts)
   BoykovJollyParameters par;
   par.Lambda = 1.0;
   const std::vector<std::vector<double>> objectSamples = { { 20, 22, 18, 25 }, { 20, 22, 18, 25 }, { 21, 19, 23, 17 },
-    { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 } };
+    { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 } };
+  // Edits 0-3 on held (owned) edge lists, which the cache keeps as they are; from 4 on a view of
+  // equal lists (compared by value: the kept flow still applies), which the new sigma of edit 6
+  // makes the cache copy, and edit 7 reuses.
+  const std::vector<std::int64_t> A(pr.Edges.First(), pr.Edges.First() + pr.Edges.Size());
+  const std::vector<std::int64_t> B(pr.Edges.Second(), pr.Edges.Second() + pr.Edges.Size());
   MaxFlowCache cache;
   for (size_t edit = 0; edit < objectSamples.size(); ++edit)
   {
+    if (edit == 4)
+    {
+      pr.Edges = GraphEdges(A, B);
+    }
     pr.ObjectSamples = objectSamples[edit];
     pr.BackgroundSamples = { 5, 3, 7, 4 + static_cast<double>(edit) };
     par.Bins = edit >= 5 ? 16 : 0;
@@ -1225,6 +1234,8 @@ TEST(GraphEdges, GridEdgesAreTheFaceNeighboursInVoxelOrderAndBlocksSplitThem)
     EXPECT_EQ(seen, grid.Size());
     EXPECT_EQ(grid.BlockStart(grid.Blocks()), grid.Size());
     EXPECT_TRUE(grid.Same(GraphEdges::Grid(d[0], d[1], d[2])));
+    const GraphEdges held = GraphEdges::Owned(A, B), copy = held;
+    EXPECT_TRUE(held.Held() && copy.Same(held) && !GraphEdges(A, B).Held());
     EXPECT_FALSE(grid.Same(GraphEdges(A, B)));
     EXPECT_TRUE(GraphEdges(A, B).Same(GraphEdges::Owned(A, B)));
   }
