@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -333,16 +334,76 @@ struct MaxFlowCache::BinnedVoxels
 
 namespace
 {
-// The runs of one bin in sorted values: bin() is monotone, so a node within one bin costs two reads,
-// one spanning several a binary search per bin. f(bin, count), bins ascending.
-template <typename Stored, typename BinFunction, typename RunFunction>
-void ForEachRun(const Stored* x, const Stored* end, int bins, const BinFunction& bin, const RunFunction& f)
+// The histogram's bins as the cut defines them, bin(v) = int((v - low) / width) clamped to
+// [0, count), with the smallest value of each bin found once (exactly: a binary search over the
+// doubles, in their order), so that sorted values split into runs by comparisons alone.
+class HistogramBins
+{
+public:
+  HistogramBins(int count, double low, double width)
+    : Count(count)
+    , Low(low)
+    , Width(width)
+    , Start(static_cast<std::size_t>(count) + 1)
+  {
+    // Doubles as unsigned keys in their numeric order.
+    auto key = [](double d) {
+      std::uint64_t u;
+      std::memcpy(&u, &d, sizeof u);
+      return (u >> 63) ? ~u : (u | (std::uint64_t(1) << 63));
+    };
+    auto value = [](std::uint64_t k) {
+      const std::uint64_t u = (k >> 63) ? (k & ~(std::uint64_t(1) << 63)) : ~k;
+      double d;
+      std::memcpy(&d, &u, sizeof d);
+      return d;
+    };
+    this->Start[0] = -std::numeric_limits<double>::infinity();
+    this->Start[count] = std::numeric_limits<double>::infinity();
+    // bin() is monotone in v (each IEEE step is), so {v : bin(v) >= b} starts at one double,
+    // between low - width and low + (count + 1) width.
+    const std::uint64_t first = key(low - width), last = key(low + (count + 1) * width);
+    for (int b = 1; b < count; ++b)
+    {
+      std::uint64_t lo = first, hi = last;
+      while (lo < hi)
+      {
+        const std::uint64_t mid = lo + (hi - lo) / 2;
+        if ((*this)(value(mid)) >= b)
+        {
+          hi = mid;
+        }
+        else
+        {
+          lo = mid + 1;
+        }
+      }
+      this->Start[b] = value(lo);
+    }
+  }
+  int Size() const { return this->Count; }
+  int operator()(double v) const { return std::min(this->Count - 1, std::max(0, static_cast<int>((v - this->Low) / this->Width))); }
+  // The smallest value of bin b (b in [0, Size()]; -inf and +inf at the ends).
+  double First(int b) const { return this->Start[b]; }
+
+private:
+  int Count;
+  double Low, Width;
+  std::vector<double> Start;
+};
+
+// The runs of one bin in sorted values: a node within one bin costs a division and a comparison,
+// one spanning several a binary search of comparisons per bin. f(bin, count), bins ascending.
+template <typename Stored, typename RunFunction>
+void ForEachRun(const Stored* x, const Stored* end, const HistogramBins& bins, const RunFunction& f)
 {
   while (x < end)
   {
-    const int b = bin(*x);
-    const Stored* next =
-      b == bins - 1 || bin(end[-1]) == b ? end : std::partition_point(x, end, [&](Stored y) { return bin(y) <= b; });
+    const int b = bins(*x);
+    const double nextBin = bins.First(b + 1);
+    const Stored* next = static_cast<double>(end[-1]) < nextBin
+      ? end
+      : std::partition_point(x, end, [&](Stored y) { return static_cast<double>(y) < nextBin; });
     constexpr std::int64_t longest = std::numeric_limits<std::uint32_t>::max();
     for (std::int64_t left = next - x; left > 0; left -= longest)
     {
@@ -354,8 +415,7 @@ void ForEachRun(const Stored* x, const Stored* end, int bins, const BinFunction&
 
 // Every node's voxel values as bin runs, in two passes over them (count, then write). False when
 // progress asked to abort.
-template <typename BinFunction>
-bool BinVoxels(const NodeVoxelValues& voxels, const BinFunction& bin, MaxFlowCache::BinnedVoxels& binned,
+bool BinVoxels(const NodeVoxelValues& voxels, const HistogramBins& bins, MaxFlowCache::BinnedVoxels& binned,
   const ParallelFor& parallel, const ProgressFunction& progress)
 {
   const std::int64_t n = static_cast<std::int64_t>(voxels.Offset.size()) - 1;
@@ -363,7 +423,7 @@ bool BinVoxels(const NodeVoxelValues& voxels, const BinFunction& bin, MaxFlowCac
   AssignFresh(offset, static_cast<std::size_t>(n + 1), std::int64_t(0));
   return voxels.Visit([&](const auto* all) {
     auto runs = [&](std::int64_t p, const auto& f) {
-      ForEachRun(all + voxels.Offset[p], all + voxels.Offset[p + 1], binned.Bins, bin, f);
+      ForEachRun(all + voxels.Offset[p], all + voxels.Offset[p + 1], bins, f);
     };
     if (!BatchedFor(n, 8192, parallel, SubProgress(progress, 0.0, 0.5), [&](std::int64_t first, std::int64_t last) {
           for (std::int64_t p = first; p < last; ++p)
@@ -460,7 +520,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     costBackground[b] = -std::log(pBackground[b]);
   }
   const double width = (high - low) / r.Bins;
-  auto bin = [&](double v) { return std::min(r.Bins - 1, std::max(0, static_cast<int>((v - low) / width))); };
+  const HistogramBins bin(r.Bins, low, width);
 
   // The boundary term depends on the graph alone: a kept flow of this very graph lends its weights
   // (and its residual graph, below).
@@ -572,7 +632,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
             for (std::int64_t p = first; p < last; ++p)
             {
               double sumObject = 0.0, sumBackground = 0.0;
-              ForEachRun(all + exact->Offset[p], all + exact->Offset[p + 1], r.Bins, bin, [&](int b, std::uint32_t count) {
+              ForEachRun(all + exact->Offset[p], all + exact->Offset[p + 1], bin, [&](int b, std::uint32_t count) {
                 sumObject += static_cast<double>(count) * costObject[b];
                 sumBackground += static_cast<double>(count) * costBackground[b];
               });
