@@ -381,8 +381,13 @@ public:
       this->Start[b] = value(lo);
     }
   }
-  int Size() const { return this->Count; }
-  int operator()(double v) const { return std::min(this->Count - 1, std::max(0, static_cast<int>((v - this->Low) / this->Width))); }
+  // Clamped before the conversion: a value far beyond the range (an outlier a billion bins away)
+  // must not overflow the int, which would put it in bin 0 and stall the runs above.
+  int operator()(double v) const
+  {
+    const double q = (v - this->Low) / this->Width;
+    return q < 1.0 ? 0 : (q >= this->Count - 1 ? this->Count - 1 : static_cast<int>(q));
+  }
   // The smallest value of bin b (b in [0, Size()]; -inf and +inf at the ends).
   double First(int b) const { return this->Start[b]; }
 

@@ -511,6 +511,51 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   EXPECT_EQ(exact.Label[2], 1);
 }
 
+TEST(BoykovJolly, AnOutlierFarBeyondTheRangeCountsInTheLastBin)
+{
+  // 40 nodes of 5 voxels in [0, 20]; the largest voxel is 25, 1e12 or 1e150, far more bins beyond
+  // the range than an int counts: all fall in the last bin (the percentile range and the means stay the same), so the
+  // cut is the same, and it finishes.
+  std::vector<double> mean;
+  std::vector<std::int32_t> owner;
+  std::vector<double> voxels;
+  for (int p = 0; p < 40; ++p)
+  {
+    double sum = 0.0;
+    for (int k = 0; k < 5; ++k)
+    {
+      voxels.push_back((p < 15 ? 15.0 : 3.0) + (k * 7 + p) % 5);
+      owner.push_back(p);
+      sum += voxels.back();
+    }
+    mean.push_back(sum / 5);
+  }
+  CutProblem pr = SeededChain(mean);
+  pr.ObjectSamples = { 15, 16, 17, 19 };
+  pr.BackgroundSamples = { 3, 4, 5, 7 };
+  std::vector<double> flows;
+  std::vector<std::vector<std::uint8_t>> labels;
+  for (const double outlier : { 25.0, 1e12, 1e150 })
+  {
+    voxels[7] = outlier;
+    NodeVoxelValues grouped;
+    std::string error;
+    ASSERT_TRUE(GroupVoxelValues(owner.data(), voxels.data(), static_cast<std::int64_t>(voxels.size()), 40, grouped,
+      error, SerialFor()));
+    pr.NodeVoxels = &grouped;
+    MaxFlowCache cache;
+    const CutResult r = BoykovJollyCut(pr, BoykovJollyParameters(), NoProgress(), &cache);
+    ASSERT_TRUE(r.Error.empty()) << r.Error;
+    flows.push_back(r.Flow);
+    labels.push_back(r.Label);
+  }
+  for (size_t k = 1; k < flows.size(); ++k)
+  {
+    EXPECT_EQ(flows[k], flows[0]) << k;
+    EXPECT_EQ(labels[k], labels[0]) << k;
+  }
+}
+
 TEST(BoykovJolly, KeptCutsEqualFreshCuts)
 {
   // 60 super-nodes of 1-40 noisy voxels each (spanning several bins), object-like first; a chain of
