@@ -260,20 +260,16 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
     badSize += (std::isfinite(size) && size >= 0.0) ? 0 : 1;
   }
   // Grid edges are valid by construction.
-  const std::int64_t blocks = edges.IsGrid() ? 0 : edges.Blocks();
-  for (std::int64_t k = 0; k < blocks; ++k)
+  const auto checkEdge = [&](std::int64_t e, std::int64_t a, std::int64_t b) {
+    badEdge += (a >= 0 && a < n && b >= 0 && b < n &&
+                 (pr.Contact.empty() || (std::isfinite(pr.Contact[e]) && pr.Contact[e] >= 0.0)))
+      ? 0
+      : 1;
+  };
+  if (!edges.IsGrid() && !edges.ForEachUntil(checkEdge, [&](double t) { return progress(0.5 * t); }))
   {
-    if ((k & 15) == 15 && !progress(0.5 * static_cast<double>(k) / static_cast<double>(blocks)))
-    {
-      aborted = true;
-      return std::string();
-    }
-    edges.ForEach(k, k + 1, [&](std::int64_t e, std::int64_t a, std::int64_t b) {
-      badEdge += (a >= 0 && a < n && b >= 0 && b < n &&
-                   (pr.Contact.empty() || (std::isfinite(pr.Contact[e]) && pr.Contact[e] >= 0.0)))
-        ? 0
-        : 1;
-    });
+    aborted = true;
+    return std::string();
   }
   for (const auto* samples : { &pr.ObjectSamples, &pr.BackgroundSamples })
   {
@@ -740,16 +736,13 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
         }
         g->add_tweights(static_cast<int>(p), source(p), sink(p));
       }
-      const std::int64_t blocks = edges.Blocks();
-      for (std::int64_t k = 0; k < blocks; ++k)
+      if (!edges.ForEachUntil(
+            [&](std::int64_t e, std::int64_t a, std::int64_t b) {
+              g->add_edge(static_cast<int>(a), static_cast<int>(b), weight[e], weight[e]);
+            },
+            [&](double t) { return !phaseAborted(0.45 + 0.05 * t); }))
       {
-        edges.ForEach(k, k + 1, [&](std::int64_t e, std::int64_t a, std::int64_t b) {
-          g->add_edge(static_cast<int>(a), static_cast<int>(b), weight[e], weight[e]);
-        });
-        if ((k & 15) == 15 && phaseAborted(0.45 + 0.05 * static_cast<double>(k) / static_cast<double>(blocks)))
-        {
-          return r;
-        }
+        return r;
       }
     }
   }

@@ -67,7 +67,7 @@ struct CutProblem
 {
   std::vector<double> Value;   // intensity of each node (mean intensity for an element)
   std::vector<double> Size;    // region-term weight of each node (its voxel count); empty = 1 each
-  GraphEdges Edges;             // a view: explicit lists (the caller keeps them) or a voxel grid
+  GraphEdges Edges;             // explicit lists (viewed, held or owned) or a voxel grid
   std::vector<double> Contact; // per edge, in voxel faces; empty = 1 each (the voxel grid)
   std::vector<std::uint8_t> Hard; // 0 free, 1 object seed, 2 background seed
   std::vector<double> ObjectSamples, ObjectWeights, BackgroundSamples, BackgroundWeights;

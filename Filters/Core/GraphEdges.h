@@ -140,6 +140,22 @@ public:
   {
     this->ForEach(0, this->Blocks(), f);
   }
+  // ForEach over every edge, asking keepGoing(fraction done) every 16 blocks (~2^18 edges); false
+  // when it answered false.
+  template <typename F, typename KeepGoing>
+  bool ForEachUntil(F&& f, KeepGoing&& keepGoing) const
+  {
+    const std::int64_t blocks = this->Blocks();
+    for (std::int64_t k = 0; k < blocks; ++k)
+    {
+      if ((k & 15) == 15 && !keepGoing(static_cast<double>(k) / static_cast<double>(blocks)))
+      {
+        return false;
+      }
+      this->ForEach(k, k + 1, f);
+    }
+    return true;
+  }
 
 private:
   // The first edge of grid row r (voxel row j of slice k): slices before k and rows before j all

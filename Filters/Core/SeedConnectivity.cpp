@@ -28,28 +28,24 @@ std::vector<std::int64_t> LabelComponents(
   std::vector<std::int64_t> parent;
   AssignFresh(parent, static_cast<std::size_t>(n));
   std::iota(parent.begin(), parent.end(), std::int64_t(0));
-  const std::int64_t blocks = edges.Blocks();
-  for (std::int64_t k = 0; k < blocks; ++k)
-  {
-    if ((k & 15) == 15 && !progress(0.9 * static_cast<double>(k) / static_cast<double>(blocks)))
+  const auto unite = [&](std::int64_t, std::int64_t p, std::int64_t q) {
+    if (label[p] == label[q])
     {
-      return {};
-    }
-    edges.ForEach(k, k + 1, [&](std::int64_t, std::int64_t p, std::int64_t q) {
-      if (label[p] == label[q])
+      std::int64_t a = Find(parent, p), b = Find(parent, q);
+      if (a != b)
       {
-        std::int64_t a = Find(parent, p), b = Find(parent, q);
-        if (a != b)
+        // The smaller root wins, so a component's root is its first node whatever the edge order.
+        if (b < a)
         {
-          // The smaller root wins, so a component's root is its first node whatever the edge order.
-          if (b < a)
-          {
-            std::swap(a, b);
-          }
-          parent[b] = a;
+          std::swap(a, b);
         }
+        parent[b] = a;
       }
-    });
+    }
+  };
+  if (!edges.ForEachUntil(unite, [&](double t) { return progress(0.9 * t); }))
+  {
+    return {};
   }
   for (std::int64_t p = 0; p < n; ++p)
   {
