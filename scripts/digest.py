@@ -2,8 +2,8 @@
 
 usage: pvpython scripts/digest.py [--cases a,b] [--out FILE] [--cut Lambda=1,Connectivity=0]
 For each case (bundled Data/ and ../shared/data/cases) prints one line per output: the SHA-256 of
-the node points and arrays, of the mesh (points, cells, every cell array by value), of the
-smoothed mesh (stage 3 at its defaults, default backend), of the
+the node points and arrays, of the mesh (points, cells, every cell array by value) and of its
+voxel -> element map, of the smoothed mesh (stage 3 at its defaults, default backend) and its map, of the
 super-voxel labels (cells and label image), of Segmentation Surface Smoothing's output (the labelled
 mesh's points and the boundary's faces) and of the voxel cut's labels, at the default
 properties (--cut overrides properties of both cuts, e.g. the defaults of an older commit); 3D cases
@@ -37,6 +37,12 @@ def cell_array(data, names):
     raise KeyError(names)
 
 
+def owners(data):
+    """The voxel -> element map a mesh carries (field array VoxelOwner), or "none"."""
+    a = data.GetFieldData().GetArray("VoxelOwner")
+    return sha(fm.v2n(a)) if a is not None else "none"
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--cases", default="")
@@ -58,6 +64,7 @@ def main():
             tag = "%s/%s" % (name, "CGAL" if backend else "default")
             lines.append("%s mesh %s" % (tag, sha(fm.v2n(m.GetPoints().GetData()), fm.v2n(m.GetCells().GetConnectivityArray()),
                                                   *[cell_array(m, a) for a in CELL_ARRAYS])))
+            lines.append("%s mesh owners %s" % (tag, owners(m)))
             cut = case.super_voxel_cut(mesh, **cut_properties)
             lines.append("%s labels %s" % (tag, sha(fm.v2n(fm.fetch(cut, 0).GetCellData().GetArray("Label")),
                                                     fm.v2n(fm.fetch(cut, 2).GetPointData().GetScalars()))))
@@ -70,6 +77,7 @@ def main():
                 s = fm.fetch(smoothed)
                 lines.append("%s smoothed %s" % (tag, sha(fm.v2n(s.GetPoints().GetData()), fm.v2n(s.GetCells().GetConnectivityArray()),
                                                           *[cell_array(s, a) for a in CELL_ARRAYS])))
+                lines.append("%s smoothed owners %s" % (tag, owners(s)))
         lines.append("%s voxelcut %s" % (name, sha(fm.v2n(fm.fetch(case.voxel_cut(**cut_properties)).GetPointData().GetScalars()))))
         print(lines[-1], flush=True)
     text = "\n".join(lines) + "\n"

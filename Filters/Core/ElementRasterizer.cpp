@@ -120,19 +120,22 @@ ElementStatistics ComputeElementStatistics(const ElementRasterizer& raster, cons
       // nearly constant elements, and half the memory traffic of a two-pass variance.
       std::int64_t count = 0;
       double shift = 0.0, sum = 0.0, ss = 0.0;
-      raster.ForEachVoxel(c, [&](std::int64_t v) {
+      raster.ForEachSpan(c, [&](std::int64_t first, std::int64_t n) {
         if (owner)
         {
-          owner[v] = static_cast<std::int32_t>(c);
+          std::fill_n(owner + first, n, static_cast<std::int32_t>(c));
         }
         if (count == 0)
         {
-          shift = static_cast<double>(values[v]);
+          shift = static_cast<double>(values[first]);
         }
-        ++count;
-        const double d = static_cast<double>(values[v]) - shift;
-        sum += d;
-        ss += d * d;
+        count += n;
+        for (const T* v = values + first; v != values + first + n; ++v)
+        {
+          const double d = static_cast<double>(*v) - shift;
+          sum += d;
+          ss += d * d;
+        }
       });
       if (count == 0)
       {
@@ -189,7 +192,9 @@ std::vector<std::int32_t> VoxelOwners(const ElementRasterizer& raster, const Par
     for (std::int64_t i = b; i < e; ++i)
     {
       const std::int64_t c = order[i];
-      raster.ForEachVoxel(c, [&](std::int64_t v) { owner[v] = static_cast<std::int32_t>(c); });
+      raster.ForEachSpan(c, [&](std::int64_t first, std::int64_t n) {
+        std::fill_n(owner.begin() + first, n, static_cast<std::int32_t>(c));
+      });
     }
   });
   return done ? owner : std::vector<std::int32_t>();

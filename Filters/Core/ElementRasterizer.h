@@ -33,9 +33,22 @@ public:
   const SimplexMesh& Mesh() const { return *this->M; }
   std::int64_t NumberOfElements() const { return this->M->NumberOfElements(); }
 
+  // Calls visit(firstVoxelIndex, count) for runs of consecutive voxel centres along x owned by the
+  // element, in raster order: together, every owned centre once.
+  template <typename SpanVisitor>
+  void ForEachSpan(std::int64_t e, SpanVisitor&& visit) const;
+
   // Calls visit(voxelIndex) for every voxel centre owned by the element, in raster order.
   template <typename Visitor>
-  void ForEachVoxel(std::int64_t e, Visitor&& visit) const;
+  void ForEachVoxel(std::int64_t e, Visitor&& visit) const
+  {
+    this->ForEachSpan(e, [&](std::int64_t first, std::int64_t count) {
+      for (std::int64_t v = first; v < first + count; ++v)
+      {
+        visit(v);
+      }
+    });
+  }
 
   // The elements in Morton order of their lowest voxel corner (4-voxel blocks): a pass over them
   // in this order reads and writes neighbouring voxels, where mesher order jumps across the image
@@ -57,6 +70,7 @@ private:
   };
   bool Owns(const Face* face, int faces, bool offLattice, double x, double y, double z) const;
   bool ExactTie(const Face& face, int faces) const;
+  bool LatticeTie(const double* n, int faces, double x, double y, double z) const;
 
   const SimplexMesh* M;
   double TwiceCentre[3];
@@ -164,30 +178,24 @@ inline bool ElementRasterizer::Owns(const Face* face, int faces, bool offLattice
       return false;
     }
     // On the face plane: decide by the pull towards the box centre, then lexicographically.
-    if (offLattice)
-    {
-      if (!this->ExactTie(face[f], faces))
-      {
-        return false;
-      }
-      continue;
-    }
-    const double toCentre = n[0] * (this->TwiceCentre[0] - 2 * x) + n[1] * (this->TwiceCentre[1] - 2 * y) +
-      (faces == 3 ? 0.0 : n[2] * (this->TwiceCentre[2] - 2 * z));
-    if (toCentre < 0)
+    if (offLattice ? !this->ExactTie(face[f], faces) : !this->LatticeTie(n, faces, x, y, z))
     {
       return false;
     }
-    if (toCentre == 0)
-    {
-      const bool positive = n[0] > 0 || (n[0] == 0 && (n[1] > 0 || (n[1] == 0 && n[2] > 0)));
-      if (!positive)
-      {
-        return false;
-      }
-    }
   }
   return true;
+}
+
+// The tie rule for a lattice element's centre on face plane n (exact integer arithmetic).
+inline bool ElementRasterizer::LatticeTie(const double* n, int faces, double x, double y, double z) const
+{
+  const double toCentre = n[0] * (this->TwiceCentre[0] - 2 * x) + n[1] * (this->TwiceCentre[1] - 2 * y) +
+    (faces == 3 ? 0.0 : n[2] * (this->TwiceCentre[2] - 2 * z));
+  if (toCentre != 0)
+  {
+    return toCentre > 0;
+  }
+  return n[0] > 0 || (n[0] == 0 && (n[1] > 0 || (n[1] == 0 && n[2] > 0)));
 }
 
 // The tie rule with exact signs, for a centre exactly on a face of an element off the lattice: on
@@ -219,8 +227,8 @@ inline bool ElementRasterizer::ExactTie(const Face& F, int faces) const
   return F.Sign * side > 0;
 }
 
-template <typename Visitor>
-void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
+template <typename SpanVisitor>
+void ElementRasterizer::ForEachSpan(std::int64_t e, SpanVisitor&& visit) const
 {
   const std::int64_t* cell = this->M->Cell(e);
   const auto& P = this->M->Points();
@@ -298,15 +306,62 @@ void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
   const int j0 = std::max(0, static_cast<int>(std::ceil(lo[1]))), j1 = std::min(G.Dims[1] - 1, static_cast<int>(std::floor(hi[1])));
   const int k0 = faces == 3 ? 0 : std::max(0, static_cast<int>(std::ceil(lo[2])));
   const int k1 = faces == 3 ? 0 : std::min(G.Dims[2] - 1, static_cast<int>(std::floor(hi[2])));
+  // Row bounds are products with 1/a (a: a face's x coefficient), their rounding (a few ulps of
+  // bounds within the box) far below Margin voxels: the candidates only grow by it and the interior
+  // only shrinks, and Owns decides every candidate outside the interior exactly.
+  constexpr double Margin = 1e-7;
+  double inverse[4];
+  for (int f = 0; f < faces; ++f)
+  {
+    inverse[f] = face[f].Plane[0] != 0.0 ? 1.0 / face[f].Plane[0] : 0.0;
+  }
+  // On the lattice without exact bounds (a dimension of 4096 or more) b may be rounded: no interior.
+  const bool exactRows = offLattice || this->ExactBounds;
+  const int widen = this->ExactBounds || offLattice ? 0 : 1;
   for (int k = k0; k <= k1; ++k)
   {
-    for (int j = j0; j <= j1; ++j)
+    // A tetrahedron's rows in slice k: the y-range of its cross-section (where its edges cross
+    // z = k), widened far beyond the rounding; rows outside it own nothing.
+    int jLo = j0, jHi = j1;
+    if (faces == 4)
     {
-      // Candidate x-interval from the face planes, widened by one voxel; the exact test decides.
-      // Off the lattice b carries rounding, which a plane nearly parallel to x (tiny a) magnifies:
-      // the bounds move out by that error, so that the interval stays a superset.
+      double yLo = 1e300, yHi = -1e300;
+      for (int a = 0; a < 4; ++a)
+      {
+        const auto& p = P[cell[a]];
+        if (p[2] == k)
+        {
+          yLo = std::min(yLo, p[1]);
+          yHi = std::max(yHi, p[1]);
+        }
+        for (int b = a + 1; b < 4; ++b)
+        {
+          const auto& q = P[cell[b]];
+          if ((p[2] < k && q[2] > k) || (p[2] > k && q[2] < k))
+          {
+            const double y = p[1] + (k - p[2]) / (q[2] - p[2]) * (q[1] - p[1]);
+            yLo = std::min(yLo, y);
+            yHi = std::max(yHi, y);
+          }
+        }
+      }
+      if (!(yLo <= yHi))
+      {
+        continue;
+      }
+      jLo = std::max(j0, static_cast<int>(std::ceil(yLo - 1e-6)));
+      jHi = std::min(j1, static_cast<int>(std::floor(yHi + 1e-6)));
+    }
+    for (int j = jLo; j <= jHi; ++j)
+    {
+      // Candidate x-interval from the face planes; within it, centres strictly inside every face
+      // by more than 3 slacks are owned without a test (below): (inLo, inHi). Off the lattice b
+      // carries rounding, which a plane nearly parallel to x (tiny a) magnifies: the slack moves
+      // each bound out by at least 1e-9 (1 + Dims[0]) voxels (Band >= 1e-9 |a|), beyond that
+      // rounding, and covers the band Owns decides exactly.
       double xlo = i0, xhi = i1;
-      bool empty = false;
+      double inLo = -1e300, inHi = 1e300;
+      bool empty = false, interior = exactRows;
       for (int f = 0; f < faces && !empty; ++f)
       {
         const double* n = face[f].Plane;
@@ -315,36 +370,65 @@ void ElementRasterizer::ForEachVoxel(std::int64_t e, Visitor&& visit) const
         const double slack = offLattice ? face[f].Band * (1.0 + G.Dims[0] + j + k) : 0.0;
         if (a > 0)
         {
-          xlo = std::max(xlo, (-b - slack) / a);
+          xlo = std::max(xlo, (-b - slack) * inverse[f]);
+          inLo = std::max(inLo, (-b + 3 * slack) * inverse[f]);
         }
         else if (a < 0)
         {
-          xhi = std::min(xhi, (-b - slack) / a);
+          xhi = std::min(xhi, (-b - slack) * inverse[f]);
+          inHi = std::min(inHi, (-b + 3 * slack) * inverse[f]);
         }
         else if (b < -slack)
         {
           empty = true;
         }
+        else if (b == 0.0 && !offLattice)
+        {
+          // The row lies in the face's plane: the tie rule, which x does not enter (n[0] = 0),
+          // decides it whole.
+          empty = !this->LatticeTie(n, faces, 0.0, j, k);
+        }
+        else
+        {
+          interior = interior && b > 3 * slack;
+        }
       }
-      // On the lattice the bounds are exact: the plane's integers stay below 2^53 and a quotient
-      // -b/a that is not an integer lies at least 1/|a| from one, far beyond its rounding, so its
-      // ceiling and floor are those of the exact bound and no widening is needed. Off the lattice
-      // the slack moves each bound out by at least 1e-9 (1 + Dims[0]) voxels (Band >= 1e-9 |a|),
-      // beyond the quotient's rounding (~1e-16 of the coordinates), and covers the band Owns
-      // decides exactly.
-      const int widen = this->ExactBounds || offLattice ? 0 : 1;
-      if (empty || xlo > xhi + widen)
+      if (empty || xlo - Margin > xhi + Margin + widen)
       {
         continue;
       }
-      const int s = std::max(i0, static_cast<int>(std::ceil(xlo)) - widen);
-      const int t = std::min(i1, static_cast<int>(std::floor(xhi)) + widen);
-      std::int64_t idx = G.Index(s, j, k);
-      for (int i = s; i <= t; ++i, ++idx)
+      const int s = std::max(i0, static_cast<int>(std::ceil(xlo - Margin)) - widen);
+      const int t = std::min(i1, static_cast<int>(std::floor(xhi + Margin)) + widen);
+      // Strictly inside: i > inLo and i < inHi. On the lattice (exact b) every lambda there is a
+      // positive integer, which Owns computes exactly. Off it, lambda exceeds 3 slacks less the
+      // rounding of b (far below a slack): above the band, so Owns takes the rounded sign, positive.
+      int u = t + 1, w = t;
+      if (interior && inLo + Margin < t && inHi - Margin > s)
+      {
+        u = inLo + Margin < s ? s : static_cast<int>(std::floor(inLo + Margin)) + 1;
+        w = inHi - Margin > t ? t : static_cast<int>(std::ceil(inHi - Margin)) - 1;
+        if (u > w)
+        {
+          u = t + 1, w = t;
+        }
+      }
+      const std::int64_t row = G.Index(0, j, k);
+      for (int i = s; i < u; ++i)
       {
         if (this->Owns(face, faces, offLattice, i, j, k))
         {
-          visit(idx);
+          visit(row + i, std::int64_t(1));
+        }
+      }
+      if (u <= w)
+      {
+        visit(row + u, static_cast<std::int64_t>(w - u + 1));
+      }
+      for (int i = std::max(s, w + 1); i <= t; ++i)
+      {
+        if (this->Owns(face, faces, offLattice, i, j, k))
+        {
+          visit(row + i, std::int64_t(1));
         }
       }
     }

@@ -384,6 +384,64 @@ TEST(Tiling, EveryCentreHasExactlyOneOwnerOffTheLattice)
   }
 }
 
+// Large elements on a coarse grid of lattice nodes: faces parallel to x hold whole rows of centres
+// (decided by the tie rule once per row) and long runs lie strictly inside (owned without a test);
+// then the same nodes moved by multiples of 1/1024 voxel, as smoothing leaves them. Every centre
+// has exactly one owner, and each element's spans come in ascending voxel order.
+TEST(Tiling, CoarseElementsSpansCoverEveryCentreOnce)
+{
+  for (int dimension = 2; dimension <= 3; ++dimension)
+  {
+    for (int moved = 0; moved <= 1; ++moved)
+    {
+      ImageGeometry g;
+      g.Dims = dimension == 2 ? std::array<int, 3>{ { 61, 47, 1 } } : std::array<int, 3>{ { 31, 26, 21 } };
+      std::mt19937 rng(7 + moved);
+      std::vector<std::array<double, 3>> pts;
+      const int step = 5;
+      for (int k = 0; k < g.Dims[2]; k += (dimension == 2 ? 1 : step))
+        for (int j = 0; j < g.Dims[1]; j += step)
+          for (int i = 0; i < g.Dims[0]; i += step)
+          {
+            std::array<double, 3> p{ { double(std::min(i, g.Dims[0] - 1)), double(std::min(j, g.Dims[1] - 1)),
+              double(std::min(k, g.Dims[2] - 1)) } };
+            for (int a = 0; a < dimension && moved; ++a)
+              if (p[a] > 0 && p[a] < g.Dims[a] - 1)
+                p[a] += static_cast<double>(static_cast<int>(rng() % 1025) - 512) / 1024.0;
+            pts.push_back(p);
+          }
+      for (int c = 0; c < (dimension == 2 ? 4 : 8); ++c)
+        pts.push_back({ { (c & 1) ? g.Dims[0] - 1.0 : 0, (c & 2) ? g.Dims[1] - 1.0 : 0, (c & 4) ? g.Dims[2] - 1.0 : 0 } });
+      std::sort(pts.begin(), pts.end());
+      pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+      DelaunayOptions o;
+      o.Backend = DelaunayBackend::CGAL;
+      const DelaunayResult mesh = dimension == 2 ? Triangulate2D(pts) : Tetrahedralize(pts, o);
+      ASSERT_TRUE(mesh.Error.empty()) << mesh.Error;
+      SimplexMesh simplices(g, mesh.Points, mesh.Cells, mesh.VerticesPerCell);
+      simplices.OrientPositively();
+      ElementRasterizer raster(simplices);
+      std::vector<int> owners(g.Size(), 0);
+      std::int64_t longest = 0;
+      for (std::int64_t e = 0; e < raster.NumberOfElements(); ++e)
+      {
+        std::int64_t next = -1;
+        raster.ForEachSpan(e, [&](std::int64_t first, std::int64_t count) {
+          ASSERT_GE(count, 1);
+          ASSERT_GE(first, next) << "element " << e;
+          next = first + count;
+          longest = std::max(longest, count);
+          for (std::int64_t v = first; v < first + count; ++v)
+            owners[v]++;
+        });
+      }
+      for (std::int64_t v = 0; v < g.Size(); ++v)
+        ASSERT_EQ(owners[v], 1) << "dimension " << dimension << ", moved " << moved << ", voxel " << v;
+      EXPECT_GE(longest, 3) << "no long interior run: the test does not reach the untested path";
+    }
+  }
+}
+
 TEST(Delaunay, DegenerateInputIsAnError)
 {
   std::vector<std::array<double, 3>> line = { { { 0, 0, 0 } }, { { 1, 1, 0 } }, { { 2, 2, 0 } } };
