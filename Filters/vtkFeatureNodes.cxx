@@ -33,6 +33,7 @@ vtkFeatureNodes::vtkFeatureNodes()
   this->LowThreshold = defaults.LowThreshold;
   this->HighThreshold = defaults.HighThreshold;
   this->MaximumPercentile = defaults.MaximumPercentile;
+  this->NoiseFloor = defaults.NoiseFloor;
   this->CovarianceNeighbourhood = defaults.CovarianceNeighbourhood;
   this->Halftoning = defaults.Halftoning;
   this->HalftoneThreshold = defaults.HalftoneThreshold;
@@ -120,6 +121,7 @@ int vtkFeatureNodes::Execute(vtkInformationVector** inputVector, vtkInformationV
   p.LowThreshold = this->LowThreshold;
   p.HighThreshold = this->HighThreshold;
   p.MaximumPercentile = this->MaximumPercentile;
+  p.NoiseFloor = this->NoiseFloor;
   p.CovarianceNeighbourhood = this->CovarianceNeighbourhood;
   p.Halftoning = this->Halftoning;
   p.HalftoneThreshold = this->HalftoneThreshold;
@@ -235,6 +237,7 @@ int vtkFeatureNodes::Execute(vtkInformationVector** inputVector, vtkInformationV
   counts->SetComponentName(3, "Boundary");
   counts->InsertNextTuple4(result.Counts[0], result.Counts[1], result.Counts[2], result.Counts[3]);
   output->GetFieldData()->AddArray(counts);
+  AddFieldValue(output, names::NoiseSigma, result.NoiseSigma);
   vtkNew<vtkDoubleArray> timing;
   timing->SetName(names::StepSeconds);
   timing->SetNumberOfComponents(static_cast<int>(result.StepSeconds.size()) + 1);
@@ -267,6 +270,7 @@ void vtkFeatureNodes::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "LowThreshold: " << this->LowThreshold << "\n";
   os << indent << "HighThreshold: " << this->HighThreshold << "\n";
   os << indent << "MaximumPercentile: " << this->MaximumPercentile << "\n";
+  os << indent << "NoiseFloor: " << this->NoiseFloor << "\n";
   os << indent << "CovarianceNeighbourhood: " << this->CovarianceNeighbourhood << "\n";
   os << indent << "Halftoning: " << this->Halftoning << "\n";
   os << indent << "HalftoneThreshold: " << this->HalftoneThreshold << "\n";

@@ -49,6 +49,12 @@ public:
   vtkSetMacro(MaximumPercentile, double);
   vtkGetMacro(MaximumPercentile, double);
 
+  /// Noise floor: Canny's thresholds and the feature map stay above the image's estimated noise
+  /// (FeatureNodeParameters::NoiseFloor). Default on; the noise's deviation is field data NoiseSigma.
+  vtkSetMacro(NoiseFloor, bool);
+  vtkGetMacro(NoiseFloor, bool);
+  vtkBooleanMacro(NoiseFloor, bool);
+
   /// Edge (voxels) of the neighbourhood for the PCA covariance; 0 = thesis default (11 in 2D, 5 in 3D).
   vtkSetMacro(CovarianceNeighbourhood, int);
   vtkGetMacro(CovarianceNeighbourhood, int);
@@ -113,6 +119,7 @@ protected:
   int UniformSpacing;
   int BoundarySpacing;
   bool SeedAware;
+  bool NoiseFloor;
   int EdgeGateRadius;
   int CoarseningLevels;
 

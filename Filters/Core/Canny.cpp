@@ -28,7 +28,8 @@ inline std::array<int, 3> QuantisedDirection(float gx, float gy, float gz)
 } // namespace
 
 std::vector<std::uint8_t> CannyEdges(const float* f, const ImageGeometry& g, double low, double high, double percentile,
-  const ParallelFor& parallel, double* gradientMaximum, float* magnitudeBuffer)
+  const ParallelFor& parallel, double* gradientMaximum, float* magnitudeBuffer, double lowFloor, double highFloor,
+  double smoothingSigma)
 {
   const std::int64_t n = g.Size();
   std::vector<float> ownMagnitude(magnitudeBuffer ? 0 : n);
@@ -45,10 +46,18 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const ImageGeometry& g, dou
   {
     return state;
   }
-  const float lowValue = static_cast<float>(low * gmax);
-  const float highValue = static_cast<float>(high * gmax);
+  const float lowValue = static_cast<float>(std::max(low * gmax, lowFloor));
+  const float highValue = static_cast<float>(std::max(high * gmax, highFloor));
   const std::int64_t sy = g.Dims[0], sz = g.SliceStride();
   const std::int64_t rows = static_cast<std::int64_t>(g.Dims[1]) * g.Dims[2];
+  // Near the border the noise's gradient varies more: the floors grow with it there.
+  const bool floored = lowFloor > 0.0 || highFloor > 0.0;
+  std::array<std::vector<float>, 3> border;
+  for (int a = 0; a < 3 && floored; ++a)
+  {
+    border[a] = BorderNoiseFactors(g.Dims[a], smoothingSigma, { 0.5, 0.0, -0.5 });
+  }
+  const float lowFloorValue = static_cast<float>(lowFloor), highFloorValue = static_cast<float>(highFloor);
 
   // Non-maximum suppression along the quantised gradient direction; ties resolved by ">" on one
   // side and ">=" on the other, so a two-voxel plateau keeps exactly one voxel.
@@ -63,6 +72,8 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const ImageGeometry& g, dou
       const int k = static_cast<int>(r / g.Dims[1]);
       const std::int64_t row = g.Index(0, j, k);
       const bool interiorRow = g.Dims[0] > 2 && j > 0 && j + 1 < g.Dims[1] && (g.Dims[2] == 1 || (k > 0 && k + 1 < g.Dims[2]));
+      const float rowFactor = floored ? border[1][j] * border[2][k] : 1.f;
+      const float* const xFactor = floored ? border[0].data() : nullptr;
       if (interiorRow)
       {
         // Away from the border: central differences and neighbours without bounds checks (the
@@ -73,7 +84,9 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const ImageGeometry& g, dou
           // Branch-free past the threshold test, which large flat regions predict well.
           const std::int64_t idx = row + i;
           const float m = mag[idx];
-          if (m < lowV || m <= 0.f)
+          const float factor = floored ? rowFactor * xFactor[i] : 1.f;
+          const float lowAt = floored ? std::max(lowV, lowFloorValue * factor) : lowV;
+          if (m < lowAt || m <= 0.f)
           {
             continue;
           }
@@ -83,7 +96,8 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const ImageGeometry& g, dou
           const std::array<int, 3> d = QuantisedDirection(gx, gy, gz);
           const std::int64_t step = d[0] + d[1] * sy + d[2] * szz;
           const bool keep = (m > mag[idx + step]) & (m >= mag[idx - step]);
-          edgeState[idx] = static_cast<std::uint8_t>(keep * (1 + (m >= highV)));
+          const float highAt = floored ? std::max(highV, highFloorValue * factor) : highV;
+          edgeState[idx] = static_cast<std::uint8_t>(keep * (1 + (m >= highAt)));
         }
       }
       std::int64_t idx = row;
@@ -96,7 +110,10 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const ImageGeometry& g, dou
           continue;
         }
         const float m = mag[idx];
-        if (m < lowValue || m <= 0.f)
+        const float factor = floored ? rowFactor * xFactor[i] : 1.f;
+        const float lowAt = floored ? std::max(lowValue, lowFloorValue * factor) : lowValue;
+        const float highAt = floored ? std::max(highValue, highFloorValue * factor) : highValue;
+        if (m < lowAt || m <= 0.f)
         {
           continue;
         }
@@ -116,7 +133,7 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const ImageGeometry& g, dou
         }
         if (m > ahead && m >= behind)
         {
-          state[idx] = m >= highValue ? 2 : 1;
+          state[idx] = m >= highAt ? 2 : 1;
         }
       }
     }

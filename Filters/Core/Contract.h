@@ -59,6 +59,7 @@ constexpr const char* VoxelOwnerDigest = "VoxelOwnerDigest";
 // Field data: summaries.
 constexpr const char* NodeCounts = "NodeCounts";   // stage 1, per type
 constexpr const char* StepSeconds = "StepSeconds"; // stage 1, per step
+constexpr const char* NoiseSigma = "NoiseSigma";   // stage 1, the image noise's standard deviation
 constexpr const char* NumberOfNodes = "NumberOfNodes";
 constexpr const char* NumberOfElements = "NumberOfElements";
 constexpr const char* AddedNodes = "AddedNodes";

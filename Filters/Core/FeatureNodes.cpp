@@ -103,6 +103,11 @@ std::string ValidateParameters(const FeatureNodeParameters& p)
   {
     return "the low Canny threshold is above the high one; they are out of order.";
   }
+  if (!(p.NoiseLowFactor >= 0.0 && p.NoiseLowFactor <= p.NoiseHighFactor && p.NoiseHighFactor <= 100.0) ||
+    !(p.NoiseFeatureFactor >= 0.0 && p.NoiseFeatureFactor <= 100.0))
+  {
+    return "the noise factors must satisfy 0 <= low <= high <= 100 and 0 <= feature <= 100.";
+  }
   if (!(p.MaximumPercentile > 0.0 && p.MaximumPercentile <= 100.0))
   {
     return "the gradient maximum percentile must lie in (0, 100].";
@@ -184,6 +189,17 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
     });
     image = rescaled.data();
   }
+  // The noise's level, and what it gives the gradient (Canny's scale) and the Hessian diagonal.
+  double lowFloor = 0.0, highFloor = 0.0, featureFloor = 0.0;
+  if (p.NoiseFloor)
+  {
+    const double sigma = EstimateNoiseSigma(image, g, parallel);
+    out.NoiseSigma = std::ldexp(sigma, exponent);
+    const double gradient = sigma * FilteredNoiseDeviation(g.Dimension(), p.GaussianSigma, { 0.5, 0.0, -0.5 });
+    lowFloor = p.NoiseLowFactor * gradient;
+    highFloor = p.NoiseHighFactor * gradient;
+    featureFloor = p.NoiseFeatureFactor * sigma * FilteredNoiseDeviation(g.Dimension(), p.HessianSigma, { 1.0, -2.0, 1.0 });
+  }
   GaussianSmooth(image, f, g, p.GaussianSigma, parallel);
   out.StepSeconds.emplace_back("gaussian", SecondsSince(t0));
   if (!progress(0.1))
@@ -202,7 +218,7 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
   {
     const std::vector<float> fromMap = DistanceToMask(edgeInput, g, parallel);
     allCanny = CannyEdges(f, g, p.LowThreshold, p.HighThreshold, p.MaximumPercentile, parallel,
-      &out.GradientMaximum, work);
+      &out.GradientMaximum, work, lowFloor, highFloor, p.GaussianSigma);
     const float gate = static_cast<float>(p.EdgeGateRadius);
     out.EdgeMap.resize(n);
     for (std::int64_t i = 0; i < n; ++i)
@@ -221,7 +237,7 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
   else
   {
     out.EdgeMap = CannyEdges(f, g, p.LowThreshold, p.HighThreshold, p.MaximumPercentile, parallel,
-      &out.GradientMaximum, work);
+      &out.GradientMaximum, work, lowFloor, highFloor, p.GaussianSigma);
   }
   out.StepSeconds.emplace_back("canny", SecondsSince(t0));
   if (!progress(0.3))
@@ -370,7 +386,8 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
       fh = work;
       rho = f;
     }
-    HessianFeatureMap(fh, g, p.HalftoneGamma, p.FeaturePercentile, parallel, rho, &out.FeatureMaximum);
+    HessianFeatureMap(fh, g, p.HalftoneGamma, p.FeaturePercentile, parallel, rho, &out.FeatureMaximum, featureFloor,
+      p.HessianSigma);
     if (seedAware)
     {
       // The thesis's density within s of the edges that matter, a Gaussian falloff beyond.

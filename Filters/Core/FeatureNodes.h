@@ -24,6 +24,17 @@ struct FeatureNodeParameters
   double HighThreshold = 0.6;
   // Percentile of the gradient magnitude (over all voxels) taken as its maximum; 100 = plain max.
   double MaximumPercentile = 99.0;
+  // Noise floor. The thresholds above are fractions of maxima, which noise lifts less than it
+  // lifts the flat regions: on a noisy image every voxel became an edge. With NoiseFloor, Canny's
+  // low and high thresholds are at least NoiseLowFactor and NoiseHighFactor standard deviations
+  // of the noise's gradient component, and the feature map below is 0 where its Hessian norm stays
+  // under NoiseFeatureFactor deviations of the noise's Hessian diagonal; the noise's deviation is
+  // estimated from the image (EstimateNoiseSigma, 0 on a noise-free image: nothing changes). In
+  // white noise 3 % of voxels exceed the low floor, 1e-5 the high one, 1 % the feature floor.
+  bool NoiseFloor = true;
+  double NoiseLowFactor = 3.0;
+  double NoiseHighFactor = 5.0;
+  double NoiseFeatureFactor = 3.5;
   // Edge of the (cubic) neighbourhood whose edge points give the PCA covariance; 0 = 11 (2D), 5 (3D).
   int CovarianceNeighbourhood = 0;
   // Eigenvalue-ratio classes: ratio < StraightRatio -> straight/flat, < CurvedRatio -> moderate.
@@ -67,6 +78,8 @@ struct FeatureNodeResult
   std::vector<std::uint8_t> EdgeMap;
   double GradientMaximum = 0.0;
   double FeatureMaximum = 0.0;
+  // The noise's standard deviation in the image's units (0 without NoiseFloor).
+  double NoiseSigma = 0.0;
   std::int64_t EdgeVoxels = 0;
   std::int64_t Counts[4] = { 0, 0, 0, 0 };
   // Seconds spent per step, for the benchmark.

@@ -3,6 +3,7 @@
 #include "ImagingInternals.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -107,6 +108,146 @@ std::vector<float> GaussianKernel(double sigma)
     v = static_cast<float>(v / sum);
   }
   return w;
+}
+
+double EstimateNoiseSigma(const float* image, const ImageGeometry& g, const ParallelFor& parallel)
+{
+  const bool is2D = g.Is2D();
+  const int bx = g.Dims[0] / 2, by = g.Dims[1] / 2, bz = is2D ? 1 : g.Dims[2] / 2;
+  const std::int64_t blocks = static_cast<std::int64_t>(bx) * by * bz;
+  if (blocks == 0)
+  {
+    return 0.0;
+  }
+  const std::int64_t sy = g.Dims[0], sz = g.SliceStride();
+  std::vector<float> detail(static_cast<std::size_t>(blocks));
+  const std::int64_t rows = static_cast<std::int64_t>(by) * bz;
+  parallel(rows, 64, [&](std::int64_t r0, std::int64_t r1) {
+    for (std::int64_t r = r0; r < r1; ++r)
+    {
+      const int j = static_cast<int>(r % by), k = static_cast<int>(r / by);
+      const float* c = image + g.Index(0, 2 * j, is2D ? 0 : 2 * k);
+      float* out = detail.data() + r * bx;
+      for (int i = 0; i < bx; ++i, c += 2)
+      {
+        // Sums in double: the differences of large, nearly equal values stay exact enough.
+        double d = (static_cast<double>(c[0]) - c[1]) - (static_cast<double>(c[sy]) - c[sy + 1]);
+        if (!is2D)
+        {
+          d -= (static_cast<double>(c[sz]) - c[sz + 1]) - (static_cast<double>(c[sz + sy]) - c[sz + sy + 1]);
+        }
+        out[i] = static_cast<float>(std::fabs(d) / (is2D ? 2.0 : std::sqrt(8.0)));
+      }
+    }
+  });
+  auto middle = detail.begin() + blocks / 2;
+  std::nth_element(detail.begin(), middle, detail.end());
+  const double median = *middle;
+  return std::isfinite(median) ? median / 0.6745 : 0.0;
+}
+
+double FilteredNoiseDeviation(int dimension, double sigma, const std::vector<double>& taps)
+{
+  std::vector<double> kernel(1, 1.0);
+  if (sigma > 0.0)
+  {
+    const std::vector<float> w = GaussianKernel(sigma);
+    kernel.assign(w.begin(), w.end());
+  }
+  double smooth = 0.0;
+  for (const double w : kernel)
+  {
+    smooth += w * w;
+  }
+  std::vector<double> along(kernel.size() + taps.size() - 1, 0.0);
+  for (std::size_t a = 0; a < kernel.size(); ++a)
+  {
+    for (std::size_t b = 0; b < taps.size(); ++b)
+    {
+      along[a + b] += kernel[a] * taps[b];
+    }
+  }
+  double sum = 0.0;
+  for (const double w : along)
+  {
+    sum += w * w;
+  }
+  return std::sqrt(sum * std::pow(smooth, dimension - 1));
+}
+
+std::vector<float> BorderNoiseFactors(int n, double sigma, const std::vector<double>& taps)
+{
+  std::vector<float> factor(static_cast<std::size_t>(std::max(0, n)), 1.f);
+  if (n < 2)
+  {
+    return factor;
+  }
+  std::vector<double> kernel(1, 1.0);
+  if (sigma > 0.0)
+  {
+    const std::vector<float> w = GaussianKernel(sigma);
+    kernel.assign(w.begin(), w.end());
+  }
+  const int r = static_cast<int>(kernel.size() / 2), h = static_cast<int>(taps.size() / 2);
+  // Row x of the smoothing (replicated border) as weights on the input voxels.
+  auto smoothRow = [&](int x) {
+    std::vector<double> row(static_cast<std::size_t>(n), 0.0);
+    for (int t = -r; t <= r; ++t)
+    {
+      row[std::min(std::max(x + t, 0), n - 1)] += kernel[t + r];
+    }
+    return row;
+  };
+  auto deviation = [&](int x) {
+    std::vector<double> row(static_cast<std::size_t>(n), 0.0);
+    auto add = [&](int at, double w) {
+      const std::vector<double> s = smoothRow(at);
+      for (int v = 0; v < n; ++v)
+      {
+        row[v] += w * s[v];
+      }
+    };
+    if (x - h < 0 || x + h > n - 1)
+    {
+      // The gradient's one-sided difference at the ends.
+      add(std::min(x + 1, n - 1), 1.0);
+      add(std::max(x - 1, 0), -1.0);
+    }
+    else
+    {
+      for (int t = -h; t <= h; ++t)
+      {
+        add(x + t, taps[t + h]);
+      }
+    }
+    double sum = 0.0, smooth = 0.0;
+    const std::vector<double> s = smoothRow(x);
+    for (int v = 0; v < n; ++v)
+    {
+      sum += row[v] * row[v];
+      smooth += s[v] * s[v];
+    }
+    return std::make_pair(std::sqrt(sum), std::sqrt(smooth));
+  };
+  const double along = FilteredNoiseDeviation(1, sigma, taps);
+  double across = 0.0;
+  for (const double w : kernel)
+  {
+    across += w * w;
+  }
+  across = std::sqrt(across);
+  // Within r + h of an end the replicated border enters; beyond, the interior values hold.
+  for (int x = 0; x < n; ++x)
+  {
+    const int e = std::min(x, n - 1 - x);
+    if (e > r + h)
+    {
+      continue;
+    }
+    const auto d = deviation(x);
+    factor[x] = static_cast<float>(std::max({ 1.0, d.first / along, d.second / across }));
+  }
+  return factor;
 }
 
 void GaussianSmooth(const float* in, float* out, const ImageGeometry& g, double sigma, const ParallelFor& parallel)
@@ -322,7 +463,7 @@ float LargestAbsEigenvalue(float a11, float a22, float a33, float a12, float a13
 }
 
 void HessianFeatureMap(const float* f, const ImageGeometry& g, double gamma, double percentile,
-  const ParallelFor& parallel, float* rho, double* featureMaximum)
+  const ParallelFor& parallel, float* rho, double* featureMaximum, double floor, double smoothingSigma)
 {
   const std::int64_t n = g.Size();
   const int nx = g.Dims[0];
@@ -373,6 +514,28 @@ void HessianFeatureMap(const float* f, const ImageGeometry& g, double gamma, dou
       }
     }
   });
+  if (floor > 0.0)
+  {
+    std::array<std::vector<float>, 3> border;
+    for (int a = 0; a < 3; ++a)
+    {
+      border[a] = BorderNoiseFactors(g.Dims[a], smoothingSigma, { 1.0, -2.0, 1.0 });
+    }
+    const float cut = static_cast<float>(floor);
+    parallel(rows, 16, [&](std::int64_t r0, std::int64_t r1) {
+      for (std::int64_t r = r0; r < r1; ++r)
+      {
+        const int j = static_cast<int>(r % g.Dims[1]);
+        const int k = static_cast<int>(r / g.Dims[1]);
+        float* const out = rho + g.Index(0, j, k);
+        const float rowCut = cut * border[1][j] * border[2][k];
+        for (int i = 0; i < nx; ++i)
+        {
+          out[i] = out[i] < rowCut * border[0][i] ? 0.f : out[i];
+        }
+      }
+    });
+  }
   const double a = RobustMaximum(rho, n, percentile, parallel);
   if (featureMaximum)
   {

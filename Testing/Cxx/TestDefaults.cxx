@@ -40,6 +40,7 @@ int main(int argc, char* argv[])
     GETTER(vtkFeatureNodes, GaussianSigma), GETTER(vtkFeatureNodes, HessianSigma),
     GETTER(vtkFeatureNodes, LowThreshold), GETTER(vtkFeatureNodes, HighThreshold),
     GETTER(vtkFeatureNodes, MaximumPercentile), GETTER(vtkFeatureNodes, CovarianceNeighbourhood),
+    GETTER(vtkFeatureNodes, NoiseFloor),
     GETTER(vtkFeatureNodes, Halftoning), GETTER(vtkFeatureNodes, HalftoneThreshold),
     GETTER(vtkFeatureNodes, HalftoneGamma), GETTER(vtkFeatureNodes, ExclusionWindow),
     GETTER(vtkFeatureNodes, UniformSpacing), GETTER(vtkFeatureNodes, BoundarySpacing),

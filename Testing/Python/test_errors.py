@@ -21,6 +21,9 @@ if len(sys.argv) > 1:  # child: a failing Feature Nodes and a failing Super-Voxe
     cut.ObjectSeeds = c.object_seeds
     cut.UpdatePipeline()
     print("CUT CELLS", ft.fetch(cut).GetNumberOfCells(), flush=True)
+    fresh = c.mesh(c.feature_nodes())
+    fresh.UpdatePipeline()
+    print("FRESH CELLS", ft.fetch(fresh).GetNumberOfCells(), flush=True)
     sys.exit(0)
 
 run = subprocess.run([shutil.which("pvpython"), __file__, "child"], capture_output=True, text=True, timeout=300)
@@ -28,5 +31,7 @@ log = run.stdout + run.stderr
 ft.check(log.count("Feature Nodes: the Gaussian and Hessian sigmas") == 1, "Feature Nodes reports its error once (%d)" % log.count("Feature Nodes: the Gaussian"))
 ft.check("Delaunay Image Mesh:" not in log, "the failure does not cascade into a Delaunay Image Mesh error")
 ft.check(log.count("Super-Voxel Cut: 1 of 1 object seeds fall outside") == 1, "Super-Voxel Cut reports its error once")
-ft.check("MESH CELLS 22078" in log, "fixing the property re-runs the pipeline")
-ft.check("CUT CELLS 22078" in log, "fixing the seeds re-runs the cut")
+fresh = [line.split()[-1] for line in log.splitlines() if line.startswith("FRESH CELLS")]
+ft.check(len(fresh) == 1 and int(fresh[0]) > 1000, "a fresh pipeline meshes the image (%s cells)" % fresh)
+ft.check(fresh and "MESH CELLS %s" % fresh[0] in log, "fixing the property re-runs the pipeline: the fresh pipeline's mesh")
+ft.check(fresh and "CUT CELLS %s" % fresh[0] in log, "fixing the seeds re-runs the cut on it")
