@@ -452,6 +452,26 @@ TEST_P(Tiling, EveryCentreHasExactlyOneOwner)
 }
 INSTANTIATE_TEST_SUITE_P(Delaunay, Tiling, ::testing::Values(0, 1, 2));
 
+namespace
+{
+// The CGAL Delaunay mesh of distinct `pts` (index space; triangles for a 2D grid), positively
+// oriented, into `mesh`; false (with a failure) when meshing fails.
+bool CGALMeshOfNodes(const ImageGeometry& g, std::vector<std::array<double, 3>> pts, SimplexMesh& mesh)
+{
+  std::sort(pts.begin(), pts.end());
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  DelaunayOptions o;
+  o.Backend = DelaunayBackend::CGAL;
+  const DelaunayResult d = g.Is2D() ? Triangulate2D(pts) : Tetrahedralize(pts, o);
+  EXPECT_TRUE(d.Error.empty()) << d.Error;
+  if (!d.Error.empty())
+    return false;
+  mesh = SimplexMesh(g, d.Points, d.Cells, d.VerticesPerCell);
+  mesh.OrientPositively();
+  return true;
+}
+} // namespace
+
 // Nodes off the voxel lattice, as smoothing and refinement leave them: random ones, half-integers
 // (faces through centres), and lattice nodes moved by 1e-13..1e-9 (faces a hair from centres, and
 // slivers whose normals are far smaller than their rounding). Every centre still has exactly one
@@ -488,14 +508,8 @@ TEST(Tiling, EveryCentreHasExactlyOneOwnerOffTheLattice)
         }
         pts.push_back(p);
       }
-      std::sort(pts.begin(), pts.end());
-      pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
-      DelaunayOptions o;
-      o.Backend = DelaunayBackend::CGAL;
-      const DelaunayResult mesh = dimension == 2 ? Triangulate2D(pts) : Tetrahedralize(pts, o);
-      ASSERT_TRUE(mesh.Error.empty()) << mesh.Error;
-      SimplexMesh simplices(g, mesh.Points, mesh.Cells, mesh.VerticesPerCell);
-      simplices.OrientPositively();
+      SimplexMesh simplices;
+      ASSERT_TRUE(CGALMeshOfNodes(g, pts, simplices));
       ElementRasterizer raster(simplices);
       std::vector<int> owners(g.Size(), 0);
       for (std::int64_t e = 0; e < raster.NumberOfElements(); ++e)
@@ -534,14 +548,8 @@ TEST(Tiling, CoarseElementsSpansCoverEveryCentreOnce)
           }
       for (int c = 0; c < (dimension == 2 ? 4 : 8); ++c)
         pts.push_back({ { (c & 1) ? g.Dims[0] - 1.0 : 0, (c & 2) ? g.Dims[1] - 1.0 : 0, (c & 4) ? g.Dims[2] - 1.0 : 0 } });
-      std::sort(pts.begin(), pts.end());
-      pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
-      DelaunayOptions o;
-      o.Backend = DelaunayBackend::CGAL;
-      const DelaunayResult mesh = dimension == 2 ? Triangulate2D(pts) : Tetrahedralize(pts, o);
-      ASSERT_TRUE(mesh.Error.empty()) << mesh.Error;
-      SimplexMesh simplices(g, mesh.Points, mesh.Cells, mesh.VerticesPerCell);
-      simplices.OrientPositively();
+      SimplexMesh simplices;
+      ASSERT_TRUE(CGALMeshOfNodes(g, pts, simplices));
       ElementRasterizer raster(simplices);
       std::vector<int> owners(g.Size(), 0);
       std::int64_t longest = 0;
