@@ -3,7 +3,8 @@ and to 512^3, each run in a fresh process so that its peak memory is its own.
 
 usage: pvpython scripts/benchmark_scale.py [--case brain-tumour-brats-0005] [--sizes 1x,2x,512^3] [--out out/benchmark_scale]
 Each size runs stages 1 -> 2 -> 3 -> 4 at their defaults on the case's seeds (world points, so they
-hold on a resampled image) and reports each stage's seconds, the total, seconds per million voxels,
+hold on a resampled image) and reports each stage's seconds (stage 3's also split into its sweeps,
+quality refinement, sliver perturbation and statistics), the total, seconds per million voxels,
 the elements and the process's peak resident memory after each stage (the last is the run's peak). The resampled images (linear interpolation,
 the same first and last voxel centres) are written to a temporary folder first. Writes OUT.md and OUT.csv.
 """
@@ -66,6 +67,11 @@ def child(folder, image):
         # The process's peak so far: which stage sets it (after the cut: peak_gb, below).
         if key != "cut_s":
             row[key[:-2] + "_peak_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0 ** 2
+    # Stage 3's own timers: where its time goes as the mesh grows.
+    field = fm.fetch(smooth).GetFieldData()
+    for key, name in (("sweeps_s", "SweepSeconds"), ("refinement_s", "RefinementSeconds"), ("slivers_s", "SliverSeconds"),
+                      ("statistics_s", "StatisticsSeconds")):
+        row[key] = field.GetArray(name).GetTuple1(0)
     row["elements"] = fm.fetch(cut, 0).GetNumberOfCells()
     row["peak_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0 ** 2
     print("RESULT " + json.dumps(row))
@@ -114,7 +120,8 @@ def main():
                 os.remove(image)
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    keys = ["size", "voxels", "elements", "nodes_s", "mesh_s", "smoothing_s", "cut_s", "total_s", "us_per_voxel",
+    keys = ["size", "voxels", "elements", "nodes_s", "mesh_s", "smoothing_s", "sweeps_s", "refinement_s", "slivers_s",
+            "statistics_s", "cut_s", "total_s", "us_per_voxel",
             "nodes_peak_gb", "mesh_peak_gb", "smoothing_peak_gb", "peak_gb", "bytes_per_voxel"]
     machine = report.machine()
     write_table(args.out, rows, keys, "Machine: %s; %s, one run per size, each in its own process." % (machine, args.case))

@@ -27,3 +27,6 @@ if len(rows) == 2:
         ft.check(abs(r["total_s"] - sum(r[k] for k in ("nodes_s", "mesh_s", "smoothing_s", "cut_s"))) < 1e-6 and
                  abs(r["us_per_voxel"] - 1e6 * r["total_s"] / r["voxels"]) < 1e-3 * r["us_per_voxel"] and
                  0.05 < r["peak_gb"] < 20, "the figures follow from the times and the peak memory (%.2f GB)" % r["peak_gb"])
+        parts = sum(r[k] for k in ("sweeps_s", "refinement_s", "slivers_s", "statistics_s"))
+        ft.check(0 < parts <= r["smoothing_s"] and r["sweeps_s"] > 0,
+                 "stage 3's parts (%.3f s) lie within its %.3f s" % (parts, r["smoothing_s"]))
