@@ -28,11 +28,9 @@ KEYS = ["case", "level", "noise_sigma", "floor", "estimated_sigma", "nodes", "ca
         "dice_supervoxel", "dice_voxel"]
 
 
-def noisy_source(image, level, seed):
-    """A TrivialProducer holding `image` with white Gaussian noise of level x its 0.5-99.5 percentile range."""
-    values = fm.v2n(image.GetPointData().GetScalars()).astype(np.float64)
-    lo, hi = np.percentile(values, [0.5, 99.5])
-    sigma = level * (hi - lo)
+def noisy_source(image, values, sigma, seed):
+    """A TrivialProducer holding `image`'s structure and `values` (float64, one per voxel) with white
+    Gaussian noise of deviation `sigma` added."""
     noisy = (values + np.random.default_rng(seed).normal(0.0, sigma, values.shape)).astype(np.float32)
     data = vtkImageData()
     data.CopyStructure(image)
@@ -42,7 +40,7 @@ def noisy_source(image, level, seed):
     source = ps.TrivialProducer()
     source.GetClientSideObject().SetOutput(data)
     source.UpdatePipeline()
-    return source, sigma
+    return source
 
 
 def run(case, source, truth, floor):
@@ -79,10 +77,13 @@ def main():
         case = fm.Case(folder)
         truth = case.truth()
         image = fm.fetch(case.image)
+        values = fm.v2n(image.GetPointData().GetScalars()).astype(np.float64)
+        lo, hi = np.percentile(values, [0.5, 99.5])
         case.object_seeds.UpdatePipeline()
         case.background_seeds.UpdatePipeline()
         for level in [float(x) for x in args.levels.split(",")]:
-            source, sigma = noisy_source(image, level, 1)
+            sigma = level * (hi - lo)
+            source = noisy_source(image, values, sigma, 1)
             voxel = ps.VoxelCut(Input=source, ObjectSeeds=case.object_seeds, BackgroundSeeds=case.background_seeds,
                                 Scalars=["POINTS", "scalars"])
             voxel.UpdatePipeline()

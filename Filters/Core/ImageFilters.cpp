@@ -470,6 +470,14 @@ void HessianFeatureMap(const float* f, const ImageGeometry& g, double gamma, dou
   const std::int64_t sy = nx, sz = g.SliceStride();
   const std::int64_t rows = static_cast<std::int64_t>(g.Dims[1]) * g.Dims[2];
   const bool is2D = g.Is2D();
+  // The floor at each voxel: `floor` times the border factors of its row and column (0 without one).
+  std::array<std::vector<float>, 3> border;
+  for (int a = 0; a < 3; ++a)
+  {
+    border[a] = floor > 0.0 ? BorderNoiseFactors(g.Dims[a], smoothingSigma, { 1.0, -2.0, 1.0 })
+                            : std::vector<float>(static_cast<std::size_t>(g.Dims[a]), 1.f);
+  }
+  const float cut = static_cast<float>(std::max(0.0, floor));
   // Second differences need one voxel on each side: the border keeps rho = 0.
   parallel(rows, 16, [&, f, rho](std::int64_t r0, std::int64_t r1) {
     for (std::int64_t r = r0; r < r1; ++r)
@@ -477,6 +485,8 @@ void HessianFeatureMap(const float* f, const ImageGeometry& g, double gamma, dou
       const int j = static_cast<int>(r % g.Dims[1]);
       const int k = static_cast<int>(r / g.Dims[1]);
       float* const out = rho + g.Index(0, j, k);
+      const float rowCut = cut * border[1][j] * border[2][k];
+      const float* const xFactor = border[0].data();
       if (nx < 3 || j == 0 || j == g.Dims[1] - 1 || (!is2D && (k == 0 || k == g.Dims[2] - 1)))
       {
         std::fill(out, out + nx, 0.f);
@@ -495,8 +505,9 @@ void HessianFeatureMap(const float* f, const ImageGeometry& g, double gamma, dou
           const float mean = 0.5f * (hxx + hyy);
           const float d = std::sqrt(0.25f * (hxx - hyy) * (hxx - hyy) + hxy * hxy);
           const float norm = std::fabs(mean) + d; // max(|mean+d|, |mean-d|)
-          // NaN and infinities (overflowing differences) give 0, as a comparison that vectorises.
-          out[i] = norm - norm == 0.f ? norm : 0.f;
+          // NaN and infinities (overflowing differences) give 0, as a comparison that vectorises;
+          // so does a norm below the floor.
+          out[i] = norm - norm == 0.f && !(norm < rowCut * xFactor[i]) ? norm : 0.f;
         }
         continue;
       }
@@ -510,32 +521,10 @@ void HessianFeatureMap(const float* f, const ImageGeometry& g, double gamma, dou
         const float hxz = 0.25f * (c[i + 1 + sz] - c[i + 1 - sz] - c[i - 1 + sz] + c[i - 1 - sz]);
         const float hyz = 0.25f * (c[i + sy + sz] - c[i + sy - sz] - c[i - sy + sz] + c[i - sy - sz]);
         const float norm = LargestAbsEigenvalueInline(hxx, hyy, hzz, hxy, hxz, hyz);
-        out[i] = norm - norm == 0.f ? norm : 0.f;
+        out[i] = norm - norm == 0.f && !(norm < rowCut * xFactor[i]) ? norm : 0.f;
       }
     }
   });
-  if (floor > 0.0)
-  {
-    std::array<std::vector<float>, 3> border;
-    for (int a = 0; a < 3; ++a)
-    {
-      border[a] = BorderNoiseFactors(g.Dims[a], smoothingSigma, { 1.0, -2.0, 1.0 });
-    }
-    const float cut = static_cast<float>(floor);
-    parallel(rows, 16, [&](std::int64_t r0, std::int64_t r1) {
-      for (std::int64_t r = r0; r < r1; ++r)
-      {
-        const int j = static_cast<int>(r % g.Dims[1]);
-        const int k = static_cast<int>(r / g.Dims[1]);
-        float* const out = rho + g.Index(0, j, k);
-        const float rowCut = cut * border[1][j] * border[2][k];
-        for (int i = 0; i < nx; ++i)
-        {
-          out[i] = out[i] < rowCut * border[0][i] ? 0.f : out[i];
-        }
-      }
-    });
-  }
   const double a = RobustMaximum(rho, n, percentile, parallel);
   if (featureMaximum)
   {
