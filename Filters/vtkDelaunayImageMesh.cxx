@@ -54,6 +54,8 @@ int vtkDelaunayImageMesh::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
 {
   featuremesh::RequestWholeImage(inputVector[1]);
+  featuremesh::StopVoxelOwnersRequest(inputVector[0]);
+  featuremesh::StopVoxelOwnersRequest(inputVector[1]);
   return 1;
 }
 
@@ -218,9 +220,9 @@ int vtkDelaunayImageMesh::RequestData(
     t0 = Clock::now();
     const ParallelFor parallel = SMPParallelFor();
     const SimplexMesh mesh(geometry, std::move(index), std::move(delaunay.Cells), delaunay.VerticesPerCell);
-    const vtkSmartPointer<vtkIntArray> owner = NewVoxelOwnerArray(geometry.Size());
-    const ElementStatistics stats =
-      ImageElementStatistics(ElementRasterizer(mesh), values, parallel, AlgorithmProgress(this, 0.5, 0.9), owner->GetPointer(0));
+    const vtkSmartPointer<vtkIntArray> owner = VoxelOwnersWanted(outputVector) ? NewVoxelOwnerArray(geometry.Size()) : nullptr;
+    const ElementStatistics stats = ImageElementStatistics(ElementRasterizer(mesh), values, parallel,
+      AlgorithmProgress(this, 0.5, 0.9), owner ? owner->GetPointer(0) : nullptr);
     if (stats.Aborted)
     {
       return 1;
@@ -230,7 +232,10 @@ int vtkDelaunayImageMesh::RequestData(
     const double statisticsSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
     this->UpdateProgress(0.9);
     WriteImageMesh(mesh, stats, minAngle, radiusRatio, output);
-    AttachVoxelOwners(output, owner);
+    if (owner)
+    {
+      AttachVoxelOwners(output, owner);
+    }
 
     // Node arrays pass through; added nodes get NodeType Added and Fixed 1 (corners) or 0 (refinement).
     const vtkIdType nPts = mesh.NumberOfPoints();

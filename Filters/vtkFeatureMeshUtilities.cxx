@@ -13,12 +13,15 @@
 #include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
 #include "vtkDataArray.h"
+#include "vtkDataObject.h"
+#include "vtkDataSet.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkNew.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkInformationIntegerRequestKey.h"
 #include "vtkInformationVector.h"
 #include "vtkDemandDrivenPipeline.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
@@ -586,6 +589,53 @@ void AttachVoxelOwners(vtkUnstructuredGrid* mesh, vtkIntArray* owner)
   digest->SetName(names::VoxelOwnerDigest);
   digest->InsertNextValue(MeshDigest(mesh));
   mesh->GetFieldData()->AddArray(digest);
+}
+
+namespace
+{
+// A request key whose data key (what the mesh was made with) is its own.
+class VoxelOwnersKey : public vtkInformationIntegerRequestKey
+{
+public:
+  VoxelOwnersKey()
+    : vtkInformationIntegerRequestKey("VOXEL_OWNERS_REQUEST", "FeatureMesh")
+  {
+    this->DataKey = vtkInformationIntegerKey::MakeKey("VOXEL_OWNERS_MADE", "FeatureMesh");
+  }
+};
+} // namespace
+
+vtkInformationIntegerRequestKey* VoxelOwnersRequest()
+{
+  static vtkInformationIntegerRequestKey* const key = new VoxelOwnersKey; // VTK's key manager deletes it
+  return key;
+}
+
+void RequestNoVoxelOwners(vtkInformationVector* portVector)
+{
+  for (int c = 0; c < portVector->GetNumberOfInformationObjects(); ++c)
+  {
+    vtkInformation* info = portVector->GetInformationObject(c);
+    vtkDataSet* made = vtkDataSet::SafeDownCast(info->Get(vtkDataObject::DATA_OBJECT()));
+    if (info->Has(VoxelOwnersRequest()) || (made && made->GetNumberOfPoints() == 0))
+    {
+      info->Set(VoxelOwnersRequest(), 0);
+    }
+  }
+}
+
+void StopVoxelOwnersRequest(vtkInformationVector* portVector)
+{
+  for (int c = 0; c < portVector->GetNumberOfInformationObjects(); ++c)
+  {
+    portVector->GetInformationObject(c)->Remove(VoxelOwnersRequest());
+  }
+}
+
+bool VoxelOwnersWanted(vtkInformationVector* outputVector)
+{
+  vtkInformation* info = outputVector->GetInformationObject(0);
+  return !info->Has(VoxelOwnersRequest()) || info->Get(VoxelOwnersRequest()) != 0;
 }
 
 void DropVoxelOwners(vtkDataObject* object)

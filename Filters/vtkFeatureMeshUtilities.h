@@ -24,6 +24,7 @@ class vtkDataObject;
 class vtkDataArray;
 class vtkImageData;
 class vtkInformation;
+class vtkInformationIntegerRequestKey;
 class vtkInformationVector;
 class vtkPointData;
 class vtkPoints;
@@ -142,6 +143,19 @@ void AttachVoxelOwners(vtkUnstructuredGrid* mesh, vtkIntArray* owner);
 // cells as they are now; else false (the caller rasterises).
 // `owner` views the array (no copy) and keeps it alive.
 bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, VoxelOwnerMap& owner);
+// The request a consumer makes of a mesh's owner map, on the mesh's output information: 0 = none
+// wanted. Stage 3 rasterises its own moved mesh, so it asks its input for none (0.54 GB at 512^3);
+// any other consumer leaves it unset and the map is made. A request key: a change of request
+// re-executes the producer. The executive passes it upstream through any filter (ParaView puts a
+// pass-through filter on every output port); the stages stop it at their inputs.
+vtkInformationIntegerRequestKey* VoxelOwnersRequest();
+// Stage 3's request on every mesh connected to `port`: none, unless the mesh is already made and no
+// request stands (asking now would make it again: ParaView's Apply runs stages one by one).
+void RequestNoVoxelOwners(vtkInformationVector* portVector);
+// Removes the request from every input connected to `port` (called in RequestUpdateExtent).
+void StopVoxelOwnersRequest(vtkInformationVector* portVector);
+// Whether the consumers of `outputVector`'s port 0 want the owner map.
+bool VoxelOwnersWanted(vtkInformationVector* outputVector);
 // Removes the owner map from a copy that is no longer an image mesh (a labelled mesh, a moved one).
 void DropVoxelOwners(vtkDataObject* object);
 // A 64-bit digest of a grid's points and cells as stored.

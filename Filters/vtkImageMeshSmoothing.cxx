@@ -49,6 +49,8 @@ int vtkImageMeshSmoothing::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
 {
   featuremesh::RequestWholeImage(inputVector[1]);
+  featuremesh::RequestNoVoxelOwners(inputVector[0]);
+  featuremesh::StopVoxelOwnersRequest(inputVector[1]);
   return 1;
 }
 
@@ -161,9 +163,9 @@ int vtkImageMeshSmoothing::RequestData(
     std::vector<float>().swap(floatStorage); // the statistics read the array in its own type
 
     t0 = Clock::now();
-    const vtkSmartPointer<vtkIntArray> owner = NewVoxelOwnerArray(geometry.Size());
-    const ElementStatistics stats = ImageElementStatistics(
-      ElementRasterizer(result.Mesh), array, parallel, AlgorithmProgress(this, 0.6, 0.95), owner->GetPointer(0));
+    const vtkSmartPointer<vtkIntArray> owner = VoxelOwnersWanted(outputVector) ? NewVoxelOwnerArray(geometry.Size()) : nullptr;
+    const ElementStatistics stats = ImageElementStatistics(ElementRasterizer(result.Mesh), array, parallel,
+      AlgorithmProgress(this, 0.6, 0.95), owner ? owner->GetPointer(0) : nullptr);
     if (stats.Aborted)
     {
       return 1;
@@ -172,7 +174,10 @@ int vtkImageMeshSmoothing::RequestData(
     this->UpdateProgress(0.97);
     const double statisticsSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
     WriteImageMesh(result.Mesh, stats, minAngle, radiusRatio, output);
-    AttachVoxelOwners(output, owner);
+    if (owner)
+    {
+      AttachVoxelOwners(output, owner);
+    }
     PassNodeArrays(input->GetPointData(), nPts, output->GetPointData(), result.Mesh.NumberOfPoints(), nPts);
     const bool is2D = geometry.Is2D();
     AddFieldValue(output, is2D ? names::MinAngleBefore : names::MinDihedralAngleBefore, before);

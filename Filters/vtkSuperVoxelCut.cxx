@@ -111,6 +111,10 @@ int vtkSuperVoxelCut::RequestUpdateExtent(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
 {
   featuremesh::RequestWholeImage(inputVector[3]);
+  for (int port = 0; port < this->GetNumberOfInputPorts(); ++port)
+  {
+    featuremesh::StopVoxelOwnersRequest(inputVector[port]);
+  }
   return 1;
 }
 
