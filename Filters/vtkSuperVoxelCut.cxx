@@ -242,7 +242,8 @@ int vtkSuperVoxelCut::RequestData(
         switch (valuesArray->GetDataType())
         {
           vtkTemplateMacro(ready = PrepareSuperVoxelCut(prepared->Mesh, static_cast<const VTK_TT*>(valuesArray->GetVoidPointer(0)),
-                             prepared->Cut, error, SMPParallelFor(), progress));
+                             prepared->Cut, error, SMPParallelFor(), progress,
+                             std::make_shared<vtkSmartPointer<vtkDataArray>>(valuesArray)));
           default:
             error = "the array's value type is not supported.";
         }

@@ -11,6 +11,7 @@
 #include <memory>
 #include <numeric>
 #include <stdexcept>
+#include <tuple>
 #include <type_traits>
 
 namespace featuremesh
@@ -109,13 +110,58 @@ std::vector<double> SmoothedHistogram(
   return density;
 }
 
+namespace
+{
+// The value types a NodeVoxelValues may view, by ValueType.
+using VoxelTypes = std::tuple<float, double, char, signed char, unsigned char, short, unsigned short, int, unsigned int,
+  long, unsigned long, long long, unsigned long long>;
+
+template <typename T, std::size_t I = 0>
+constexpr int VoxelTypeIndex()
+{
+  if constexpr (I == std::tuple_size<VoxelTypes>::value)
+  {
+    return -1;
+  }
+  else if constexpr (std::is_same<T, std::tuple_element_t<I, VoxelTypes>>::value)
+  {
+    return static_cast<int>(I);
+  }
+  else
+  {
+    return VoxelTypeIndex<T, I + 1>();
+  }
+}
+
+// f(values as a pointer to their own type).
+template <typename F, std::size_t I = 0>
+auto VisitVoxelValues(const NodeVoxelValues& voxels, F&& f)
+{
+  if constexpr (I + 1 < std::tuple_size<VoxelTypes>::value)
+  {
+    if (voxels.ValueType != static_cast<int>(I))
+    {
+      return VisitVoxelValues<F, I + 1>(voxels, std::forward<F>(f));
+    }
+  }
+  return f(static_cast<const std::tuple_element_t<I, VoxelTypes>*>(voxels.Values));
+}
+} // namespace
+
+double NodeVoxelValues::Value(std::int64_t v) const
+{
+  return VisitVoxelValues(*this, [v](const auto* values) { return static_cast<double>(values[v]); });
+}
+
+namespace
+{
+// Node p's values in ascending order at [Offset[p], Offset[p + 1]): a counting sort by node in a
+// fixed number of voxel chunks (whatever the threads), so each node's voxels stay in raster order
+// and the result does not depend on how the work is split; then each node's values are sorted.
 template <typename T>
-bool GroupVoxelValues(const std::int32_t* owner, const T* values, std::int64_t voxels, std::int64_t nodes,
+bool SortByNode(const std::int32_t* owner, const T* values, std::int64_t voxels, std::int64_t nodes,
   NodeVoxelValues& grouped, std::string& error, const ParallelFor& parallel, const ProgressFunction& progress)
 {
-  // A counting sort by node in a fixed number of voxel chunks (whatever the threads): chunk c's
-  // voxels of node p go after those of chunks before c, so each node's voxels stay in raster order
-  // and the result does not depend on how the work is split. Then each node's values are sorted.
   constexpr std::int64_t chunks = 4;
   const std::int64_t size = (voxels + chunks - 1) / chunks;
   std::vector<std::int64_t> cursor(static_cast<size_t>(chunks * nodes), 0), badPerChunk(chunks, 0);
@@ -139,8 +185,6 @@ bool GroupVoxelValues(const std::int32_t* owner, const T* values, std::int64_t v
     error = std::to_string(bad) + " intensities are NaN, infinite or beyond +-1e150; replace or rescale them (e.g. with a Calculator) first.";
     return false;
   }
-  grouped.Low = Percentile(values, voxels, 0.5);
-  grouped.High = Percentile(values, voxels, 99.5);
   if (!progress(0.3))
   {
     return false;
@@ -187,19 +231,119 @@ bool GroupVoxelValues(const std::int32_t* owner, const T* values, std::int64_t v
   constexpr bool single = std::is_same<T, float>::value || (std::is_integral<T>::value && sizeof(T) <= 2);
   if (single)
   {
-    grouped.Double.reset();
     grouped.Single.reset(new float[total]);
     AdviseHugePages(grouped.Single.get(), total * sizeof(float));
     return scatterAndSort(grouped.Single.get());
   }
-  grouped.Single.reset();
   grouped.Double.reset(new double[total]);
   AdviseHugePages(grouped.Double.get(), total * sizeof(double));
   return scatterAndSort(grouped.Double.get());
 }
+
+// Node p's value bounds and whether voxels of more than one chunk are its own.
+template <typename T>
+bool BoundByNode(const std::int32_t* owner, const T* values, std::int64_t voxels, std::int64_t nodes,
+  NodeVoxelValues& grouped, std::string& error, const ParallelFor& parallel, const ProgressFunction& progress)
+{
+  // One pass in fixed voxel chunks (whatever the threads): each chunk's bounds of its nodes' values,
+  // merged below; a node seen by one chunk only is that chunk's alone when cuts count its voxels.
+  constexpr std::int64_t chunks = NodeVoxelValues::Chunks;
+  const std::int64_t size = (voxels + chunks - 1) / chunks;
+  std::vector<std::int64_t> badPerChunk(chunks, 0);
+  std::vector<std::vector<float>> low(chunks), high(chunks);
+  parallel(chunks, 1, [&](std::int64_t c0, std::int64_t c1) {
+    for (std::int64_t c = c0; c < c1; ++c)
+    {
+      std::vector<float>& lo = low[c];
+      std::vector<float>& hi = high[c];
+      AssignFresh(lo, static_cast<std::size_t>(nodes), std::numeric_limits<float>::infinity());
+      AssignFresh(hi, static_cast<std::size_t>(nodes), -std::numeric_limits<float>::infinity());
+      std::int64_t bad = 0;
+      for (std::int64_t v = c * size, e = std::min(voxels, (c + 1) * size); v < e; ++v)
+      {
+        const double x = static_cast<double>(values[v]);
+        bad += std::isfinite(x) && std::fabs(x) <= 1e150 ? 0 : 1;
+        const std::int32_t p = owner[v];
+        if (p >= 0)
+        {
+          // Rounded outward to float: a wider bound only adds runs of no voxels.
+          float down = static_cast<float>(x), up = down;
+          if (static_cast<double>(down) > x)
+          {
+            down = std::nextafter(down, -std::numeric_limits<float>::infinity());
+          }
+          if (static_cast<double>(up) < x)
+          {
+            up = std::nextafter(up, std::numeric_limits<float>::infinity());
+          }
+          lo[p] = std::min(lo[p], down);
+          hi[p] = std::max(hi[p], up);
+        }
+      }
+      badPerChunk[c] = bad;
+    }
+  });
+  const std::int64_t bad = std::accumulate(badPerChunk.begin(), badPerChunk.end(), std::int64_t(0));
+  if (bad)
+  {
+    error = std::to_string(bad) + " intensities are NaN, infinite or beyond +-1e150; replace or rescale them (e.g. with a Calculator) first.";
+    return false;
+  }
+  AssignFresh(grouped.Min, static_cast<std::size_t>(nodes));
+  AssignFresh(grouped.Max, static_cast<std::size_t>(nodes));
+  AssignFresh(grouped.Shared, static_cast<std::size_t>(nodes));
+  parallel(nodes, 65536, [&](std::int64_t p0, std::int64_t p1) {
+    for (std::int64_t p = p0; p < p1; ++p)
+    {
+      float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+      int seen = 0;
+      for (std::int64_t c = 0; c < chunks; ++c)
+      {
+        seen += low[c][p] <= high[c][p] ? 1 : 0;
+        lo = std::min(lo, low[c][p]);
+        hi = std::max(hi, high[c][p]);
+      }
+      grouped.Min[p] = lo;
+      grouped.Max[p] = hi;
+      grouped.Shared[p] = seen > 1 ? 1 : 0;
+    }
+  });
+  return progress(1.0);
+}
+} // namespace
+
+template <typename T>
+bool GroupVoxelValues(const std::int32_t* owner, const T* values, std::int64_t voxels, std::int64_t nodes,
+  NodeVoxelValues& grouped, std::string& error, const ParallelFor& parallel, const ProgressFunction& progress,
+  std::shared_ptr<const void> keep, std::int64_t sortedLimit)
+{
+  static_assert(VoxelTypeIndex<T>() >= 0, "a voxel value type NodeVoxelValues knows");
+  grouped = NodeVoxelValues();
+  if (voxels > static_cast<std::int64_t>(std::numeric_limits<std::uint32_t>::max()))
+  {
+    error = "the voxel region term counts voxels in 32 bits: the image has more than 4 294 967 295; turn VoxelRegionTerm off.";
+    return false;
+  }
+  const ProgressFunction part = SubProgress(progress, 0.0, 0.9);
+  if (!(voxels <= sortedLimit ? SortByNode(owner, values, voxels, nodes, grouped, error, parallel, part)
+                              : BoundByNode(owner, values, voxels, nodes, grouped, error, parallel, part)))
+  {
+    grouped = NodeVoxelValues();
+    return false;
+  }
+  grouped.Owner = owner;
+  grouped.Values = values;
+  grouped.ValueType = VoxelTypeIndex<T>();
+  grouped.Voxels = voxels;
+  grouped.Nodes = nodes;
+  grouped.Low = Percentile(values, voxels, 0.5);
+  grouped.High = Percentile(values, voxels, 99.5);
+  grouped.Keep = std::move(keep);
+  return progress(1.0);
+}
 #define FEATUREMESH_GROUP_VOXEL_VALUES(T)                                                                        \
   template bool GroupVoxelValues<T>(const std::int32_t*, const T*, std::int64_t, std::int64_t, NodeVoxelValues&, \
-    std::string&, const ParallelFor&, const ProgressFunction&);
+    std::string&, const ParallelFor&, const ProgressFunction&, std::shared_ptr<const void>, std::int64_t);
 FEATUREMESH_GROUP_VOXEL_VALUES(float)
 FEATUREMESH_GROUP_VOXEL_VALUES(double)
 FEATUREMESH_GROUP_VOXEL_VALUES(char)
@@ -246,7 +390,7 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
     static_cast<std::int64_t>(pr.Hard.size()) != n || edges.Malformed() ||
     (edges.IsGrid() && static_cast<std::int64_t>(dims[0]) * dims[1] * dims[2] != n) ||
     (!pr.Contact.empty() && static_cast<std::int64_t>(pr.Contact.size()) != m) ||
-    (pr.NodeVoxels && (static_cast<std::int64_t>(pr.NodeVoxels->Offset.size()) != n + 1 || pr.NodeVoxels->Empty())))
+    (pr.NodeVoxels && (pr.NodeVoxels->Nodes != n || pr.NodeVoxels->Empty())))
   {
     return "the graph's arrays disagree in length.";
   }
@@ -309,12 +453,12 @@ struct MaxFlowCache::Kept
   std::vector<double> Source, Sink;
 };
 
-// Node p's voxel values as runs of one bin (ascending) at [Offset[p], Offset[p + 1]), for the bins
-// of width Width from Low; empty until a binning repeats.
+// Node p's voxels as runs of one bin (ascending) at [Offset[p], Offset[p + 1]), for the bins of
+// width Width from Low.
 struct MaxFlowCache::BinnedVoxels
 {
   const NodeVoxelValues* From = nullptr;
-  std::size_t Nodes = 0;
+  std::int64_t Nodes = 0;
   int Bins = 0;
   double Low = 0.0, Width = 0.0;
   std::vector<std::int64_t> Offset;
@@ -322,8 +466,8 @@ struct MaxFlowCache::BinnedVoxels
   std::vector<std::uint32_t> Count;
   bool Matches(const NodeVoxelValues* from, int bins, double low, double width) const
   {
-    return this->From == from && this->Nodes == from->Offset.size() && this->Bins == bins &&
-      this->Low == low && this->Width == width;
+    return this->From == from && this->Nodes == from->Nodes && this->Bins == bins && this->Low == low &&
+      this->Width == width;
   }
   bool Empty() const { return this->Offset.empty(); }
 };
@@ -414,9 +558,9 @@ void ForEachRun(const Stored* x, const Stored* end, const HistogramBins& bins, c
   }
 }
 
-// Every node's voxel values as bin runs, in two passes over them (count, then write). False when
-// progress asked to abort.
-bool BinVoxels(const NodeVoxelValues& voxels, const HistogramBins& bins, MaxFlowCache::BinnedVoxels& binned,
+// Every node's sorted voxel values as bin runs, in two passes over them (count, then write). False
+// when progress asked to abort.
+bool BinSortedVoxels(const NodeVoxelValues& voxels, const HistogramBins& bins, MaxFlowCache::BinnedVoxels& binned,
   const ParallelFor& parallel, const ProgressFunction& progress)
 {
   const std::int64_t n = static_cast<std::int64_t>(voxels.Offset.size()) - 1;
@@ -449,6 +593,75 @@ bool BinVoxels(const NodeVoxelValues& voxels, const HistogramBins& bins, MaxFlow
       }
     });
   });
+}
+
+// Every node's voxels as runs of one bin: a run for every bin between those of its smallest and
+// largest value (some may hold no voxel: they add +0 to a sum), counted in one pass over the voxels
+// in NodeVoxelValues' chunks. A node only one chunk holds is counted without an atomic; the counts are
+// integers, so any split among threads gives the same runs. False when progress asked to abort.
+bool BinBoundedVoxels(const NodeVoxelValues& voxels, const HistogramBins& bin, MaxFlowCache::BinnedVoxels& binned,
+  const ParallelFor& parallel, const ProgressFunction& progress)
+{
+  const std::int64_t n = voxels.Nodes;
+  std::vector<std::int64_t>& offset = binned.Offset;
+  AssignFresh(offset, static_cast<std::size_t>(n + 1), std::int64_t(0));
+  std::vector<int> first(static_cast<std::size_t>(n));
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    const bool any = voxels.Min[p] <= voxels.Max[p];
+    first[p] = any ? bin(voxels.Min[p]) : 0;
+    offset[p + 1] = offset[p] + (any ? bin(voxels.Max[p]) - first[p] + 1 : 0);
+  }
+  AssignFresh(binned.Bin, static_cast<std::size_t>(offset[n]));
+  AssignFresh(binned.Count, static_cast<std::size_t>(offset[n]), std::uint32_t(0));
+  // Voxel v of node p counts at base[p] + bin(value).
+  std::vector<std::int64_t> base(static_cast<std::size_t>(n));
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    base[p] = offset[p] - first[p];
+  }
+  parallel(n, 65536, [&](std::int64_t p0, std::int64_t p1) {
+    for (std::int64_t p = p0; p < p1; ++p)
+    {
+      for (std::int64_t k = offset[p]; k < offset[p + 1]; ++k)
+      {
+        binned.Bin[k] = static_cast<std::uint16_t>(first[p] + (k - offset[p]));
+      }
+    }
+  });
+  if (!progress(0.2))
+  {
+    return false;
+  }
+  const std::int32_t* owner = voxels.Owner;
+  const std::uint8_t* shared = voxels.Shared.data();
+  std::uint32_t* count = binned.Count.data();
+  constexpr std::int64_t chunks = NodeVoxelValues::Chunks;
+  const std::int64_t size = (voxels.Voxels + chunks - 1) / chunks;
+  VisitVoxelValues(voxels, [&](const auto* values) {
+    parallel(chunks, 1, [&](std::int64_t c0, std::int64_t c1) {
+      for (std::int64_t c = c0; c < c1; ++c)
+      {
+        for (std::int64_t v = c * size, e = std::min(voxels.Voxels, (c + 1) * size); v < e; ++v)
+        {
+          const std::int32_t p = owner[v];
+          if (p >= 0)
+          {
+            std::uint32_t* k = count + base[p] + bin(static_cast<double>(values[v]));
+            if (shared[p])
+            {
+              __atomic_fetch_add(k, 1u, __ATOMIC_RELAXED);
+            }
+            else
+            {
+              ++*k;
+            }
+          }
+        }
+      }
+    });
+  });
+  return progress(1.0);
 }
 } // namespace
 
@@ -591,28 +804,40 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   AdviseHugePages(regionBackground.get(), n * sizeof(double));
   if (exact)
   {
-    // The bins move only when a seed sample leaves the last cut's range. A binning seen for the first
-    // time is summed straight from the values; one that repeats is kept as runs, which later cuts read.
+    // The bins move only when a seed sample leaves the last cut's range. Sorted values are summed
+    // straight from the values for a binning seen for the first time, and kept as runs once it
+    // repeats; bounded ones are binned at once (a pass over the voxels), and the runs kept.
     std::shared_ptr<MaxFlowCache::BinnedVoxels> binned = cache ? cache->Binned : nullptr;
     const bool repeated = binned && binned->Matches(exact, r.Bins, low, width);
-    if (cache && !repeated)
+    if (!repeated)
     {
+      if (cache)
+      {
+        cache->Binned.reset(); // the old runs' memory goes before the new runs are made
+      }
       binned = std::make_shared<MaxFlowCache::BinnedVoxels>();
       binned->From = exact;
-      binned->Nodes = exact->Offset.size();
+      binned->Nodes = exact->Nodes;
       binned->Bins = r.Bins;
       binned->Low = low;
       binned->Width = width;
-      cache->Binned = binned;
+      if (cache)
+      {
+        cache->Binned = binned;
+      }
     }
-    else if (repeated && binned->Empty() &&
-      !BinVoxels(*exact, bin, *binned, pr.Parallel, SubProgress(progress, 0.2, 0.28)))
+    if (binned->Empty() && (repeated || !exact->Sorted()) &&
+      !(exact->Sorted() ? BinSortedVoxels(*exact, bin, *binned, pr.Parallel, SubProgress(progress, 0.2, 0.28))
+                        : BinBoundedVoxels(*exact, bin, *binned, pr.Parallel, SubProgress(progress, 0.2, 0.28))))
     {
-      cache->Binned.reset();
+      if (cache)
+      {
+        cache->Binned.reset();
+      }
       r.Aborted = true;
       return r;
     }
-    const bool done = repeated
+    const bool done = !binned->Empty()
       ? BatchedFor(n, 16384, pr.Parallel, SubProgress(progress, 0.28, 0.3),
           [&](std::int64_t first, std::int64_t last) {
             for (std::int64_t p = first; p < last; ++p)

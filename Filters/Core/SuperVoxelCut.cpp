@@ -60,6 +60,40 @@ void SeedNeighbourhoodSamples(const VoxelValueFunction& value, const ImageGeomet
   }
 }
 
+namespace
+{
+// Appends the values of the voxels `owner` gives to element e, in raster order: those of its box
+// widened by a voxel (the map may come from the points before a world round trip, within rounding).
+void ElementVoxelValues(const SimplexMesh& mesh, const VoxelOwnerMap& owner, const NodeVoxelValues& voxels,
+  std::int64_t e, std::vector<double>& out)
+{
+  const ImageGeometry& g = mesh.Geometry();
+  std::array<int, 3> lo = g.Dims, hi{ { -1, -1, -1 } };
+  for (int k = 0; k < mesh.VerticesPerCell(); ++k)
+  {
+    const auto& q = mesh.Points()[mesh.Cell(e)[k]];
+    for (int a = 0; a < 3; ++a)
+    {
+      lo[a] = std::min(lo[a], std::max(0, static_cast<int>(std::floor(q[a])) - 1));
+      hi[a] = std::max(hi[a], std::min(g.Dims[a] - 1, static_cast<int>(std::ceil(q[a])) + 1));
+    }
+  }
+  for (int z = lo[2]; z <= hi[2]; ++z)
+  {
+    for (int y = lo[1]; y <= hi[1]; ++y)
+    {
+      for (std::int64_t v = g.Index(lo[0], y, z), end = v + (hi[0] - lo[0]) + 1; v < end; ++v)
+      {
+        if (owner[v] == e)
+        {
+          out.push_back(voxels.Value(v));
+        }
+      }
+    }
+  }
+}
+} // namespace
+
 std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale)
 {
   const FaceAdjacency& adj = mesh.Faces();
@@ -99,7 +133,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   const std::int64_t m = mesh.NumberOfElements();
   const VoxelOwnerMap& owner = data.Owner;
   if (static_cast<std::int64_t>(owner.size()) != mesh.Geometry().Size() ||
-    (data.HasVoxelValues() && static_cast<std::int64_t>(data.Voxels.Offset.size()) != m + 1))
+    (data.HasVoxelValues() && data.Voxels.Nodes != m))
   {
     result.Error = "the voxel owners do not match the mesh's image.";
     return result;
@@ -131,7 +165,9 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
         if (pr.Hard[e])
         {
           std::vector<double>& samples = pr.Hard[e] == 1 ? pr.ObjectSamples : pr.BackgroundSamples;
-          grouped.Visit([&](const auto* all) { samples.insert(samples.end(), all + grouped.Offset[e], all + grouped.Offset[e + 1]); });
+          const std::size_t first = samples.size();
+          ElementVoxelValues(mesh, owner, grouped, e, samples);
+          std::sort(samples.begin() + static_cast<std::ptrdiff_t>(first), samples.end());
         }
       }
     }

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -70,9 +71,9 @@ struct SuperVoxelCutData
 {
   // The element owning each voxel (-1 none).
   VoxelOwnerMap Owner;
-  // Each element's voxel values; empty without voxel values.
+  // The voxel values with their elements (viewed); empty without voxel values.
   NodeVoxelValues Voxels;
-  bool HasVoxelValues() const { return !this->Voxels.Offset.empty(); }
+  bool HasVoxelValues() const { return !this->Voxels.Empty(); }
 };
 
 // The element owning each voxel into `data.Owner`, by rasterising the mesh unless it already holds
@@ -81,15 +82,16 @@ bool PrepareVoxelOwners(const SimplexMesh& mesh, SuperVoxelCutData& data, const 
   const ProgressFunction& progress = NoProgress());
 
 // The owners, and `voxelValues` (optional, one per voxel of the mesh's image, in the image's own type)
-// grouped by element. False with a sentence for a bad value, without one when progress asked to abort.
+// grouped by element (BoykovJolly.h); `keep` (optional) keeps the values alive. False with a sentence for a bad value,
+// without one when progress asked to abort.
 template <typename T>
 bool PrepareSuperVoxelCut(const SimplexMesh& mesh, const T* voxelValues, SuperVoxelCutData& data, std::string& error,
-  const ParallelFor& parallel, const ProgressFunction& progress = NoProgress())
+  const ParallelFor& parallel, const ProgressFunction& progress = NoProgress(), std::shared_ptr<const void> keep = nullptr)
 {
   return PrepareVoxelOwners(mesh, data, parallel, SubProgress(progress, 0.0, voxelValues ? 0.6 : 1.0)) &&
     (!voxelValues ||
       GroupVoxelValues(data.Owner.data(), voxelValues, mesh.Geometry().Size(), mesh.NumberOfElements(), data.Voxels,
-        error, parallel, SubProgress(progress, 0.6, 1.0)));
+        error, parallel, SubProgress(progress, 0.6, 1.0), std::move(keep)));
 }
 
 // A voxel's value by index (the image, however it is stored).

@@ -689,6 +689,12 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   ASSERT_TRUE(GroupVoxelValues(o.data(), v.data(), 6, 3, twoGrouped, error, SerialFor()));
   EXPECT_EQ(twoGrouped.Offset, (std::vector<std::int64_t>{ 0, 1, 2, 6 }));
   EXPECT_EQ(std::vector<double>(twoGrouped.Double.get(), twoGrouped.Double.get() + 6), (std::vector<double>{ 10.0, 0.0, 0.0, 10.0, 10.0, 10.0 }));
+  NodeVoxelValues twoBounded;
+  ASSERT_TRUE(GroupVoxelValues(o.data(), v.data(), 6, 3, twoBounded, error, SerialFor(), NoProgress(), nullptr, 0));
+  EXPECT_FALSE(twoBounded.Sorted());
+  EXPECT_EQ(twoBounded.Min, (std::vector<float>{ 10.f, 0.f, 0.f }));
+  EXPECT_EQ(twoBounded.Max, (std::vector<float>{ 10.f, 0.f, 10.f }));
+  EXPECT_EQ(twoBounded.Shared, (std::vector<std::uint8_t>{ 0, 0, 1 })); // voxels 2-5 lie in chunks 2-5 of 8
   two.NodeVoxels = &twoGrouped;
   const std::vector<double> nan = { 1.0, std::nan(""), 2.0, 3.0, 4.0, 5.0 };
   NodeVoxelValues badGrouped;
@@ -703,7 +709,7 @@ TEST(BoykovJolly, AnOutlierFarBeyondTheRangeCountsInTheLastBin)
 {
   // 40 nodes of 5 voxels in [0, 20]; the largest voxel is 25, 1e12 or 1e150, far more bins beyond
   // the range than an int counts: all fall in the last bin (the percentile range and the means stay the same), so the
-  // cut is the same, and it finishes.
+  // cut is the same, and it finishes; with the values sorted and bounded.
   std::vector<double> mean;
   std::vector<std::int32_t> owner;
   std::vector<double> voxels;
@@ -723,13 +729,13 @@ TEST(BoykovJolly, AnOutlierFarBeyondTheRangeCountsInTheLastBin)
   pr.BackgroundSamples = { 3, 4, 5, 7 };
   std::vector<double> flows;
   std::vector<std::vector<std::uint8_t>> labels;
-  for (const double outlier : { 25.0, 1e12, 1e150 })
+  for (const double outlier : { 25.0, 1e12, 1e150, 25.0, 1e12, 1e150 })
   {
     voxels[7] = outlier;
     NodeVoxelValues grouped;
     std::string error;
     ASSERT_TRUE(GroupVoxelValues(owner.data(), voxels.data(), static_cast<std::int64_t>(voxels.size()), 40, grouped,
-      error, SerialFor()));
+      error, SerialFor(), NoProgress(), nullptr, flows.size() < 3 ? SortedVoxelLimit : 0));
     pr.NodeVoxels = &grouped;
     MaxFlowCache cache;
     const CutResult r = BoykovJollyCut(pr, BoykovJollyParameters(), NoProgress(), &cache);
@@ -744,11 +750,111 @@ TEST(BoykovJolly, AnOutlierFarBeyondTheRangeCountsInTheLastBin)
   }
 }
 
+TEST(BoykovJolly, VoxelRegionTermCountsEveryVoxelInItsBin)
+{
+  // 50 nodes whose voxels (300 k, more than one pass block, some owned by none) lie scattered
+  // through the volume, spanning several bins each. With no boundary term each free node pays the
+  // cheaper of its two region costs, so the flow is the sum of those minima: computed here voxel by
+  // voxel, it must equal the cut's: sorted or bounded values, a serial or a chunked (any thread
+  // split) pass, one or two words of bins per node.
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> node(-1, 49);
+  std::normal_distribution<double> noise(0.0, 4.0);
+  const std::int64_t voxels = 300000;
+  std::vector<std::int32_t> owner(voxels);
+  std::vector<float> values(voxels);
+  std::vector<double> sum(50, 0.0), count(50, 0.0);
+  for (std::int64_t v = 0; v < voxels; ++v)
+  {
+    owner[v] = node(rng);
+    values[v] = static_cast<float>((owner[v] >= 0 && owner[v] < 20 ? 30.0 : 10.0) + noise(rng));
+    if (owner[v] >= 0)
+    {
+      sum[owner[v]] += values[v];
+      count[owner[v]] += 1.0;
+    }
+  }
+  std::vector<double> mean(50);
+  for (int p = 0; p < 50; ++p)
+  {
+    mean[p] = sum[p] / count[p];
+  }
+  CutProblem pr = SeededChain(mean);
+  pr.Size = count;
+  std::fill(pr.Contact.begin(), pr.Contact.end(), 0.0);
+  pr.ObjectSamples = { 28, 30, 33, 31, 26 };
+  pr.BackgroundSamples = { 8, 12, 10, 9, 14 };
+  const std::vector<std::pair<std::int64_t, int>> forms = { { SortedVoxelLimit, 64 }, { SortedVoxelLimit, 100 }, { 0, 64 }, { 0, 100 } };
+  for (const auto& [sortedLimit, bins] : forms)
+  {
+    NodeVoxelValues viewed;
+    std::string error;
+    ASSERT_TRUE(GroupVoxelValues(owner.data(), values.data(), voxels, 50, viewed, error, SerialFor(), NoProgress(), nullptr,
+      sortedLimit)) << error;
+    EXPECT_EQ(viewed.Sorted(), sortedLimit > 0);
+    pr.NodeVoxels = &viewed;
+    BoykovJollyParameters par;
+    par.Bins = bins;
+    pr.Parallel = SerialFor();
+    const CutResult serial = BoykovJollyCut(pr, par);
+    const ParallelFor chunked = [](std::int64_t n, std::int64_t, const RangeFunction& body) {
+      for (std::int64_t b = ((n - 1) / 3) * 3; b >= 0; b -= 3)
+        body(b, std::min(n, b + 3));
+    };
+    pr.Parallel = chunked;
+    const CutResult split = BoykovJollyCut(pr, par);
+    ASSERT_TRUE(serial.Error.empty() && split.Error.empty());
+    EXPECT_EQ(split.Flow, serial.Flow);
+    EXPECT_EQ(split.Label, serial.Label);
+
+    double low = viewed.Low, high = viewed.High;
+    for (const auto* samples : { &pr.ObjectSamples, &pr.BackgroundSamples })
+    {
+      for (double x : *samples)
+      {
+        low = std::min(low, x);
+        high = std::max(high, x);
+      }
+    }
+    const double width = (high - low) / bins;
+    const std::vector<double> object = SmoothedHistogram(pr.ObjectSamples, {}, low, high, bins);
+    const std::vector<double> background = SmoothedHistogram(pr.BackgroundSamples, {}, low, high, bins);
+    std::vector<std::vector<double>> perBin(50, std::vector<double>(bins, 0.0));
+    for (std::int64_t v = 0; v < voxels; ++v)
+    {
+      if (owner[v] >= 0)
+      {
+        const double q = (static_cast<double>(values[v]) - low) / width;
+        perBin[owner[v]][q < 1.0 ? 0 : (q >= bins - 1 ? bins - 1 : static_cast<int>(q))] += 1.0;
+      }
+    }
+    double flow = 0.0;
+    int spanning = 0;
+    for (int p = 1; p < 49; ++p)
+    {
+      double costObject = 0.0, costBackground = 0.0;
+      for (int b = 0; b < bins; ++b)
+      {
+        if (perBin[p][b] > 0.0)
+        {
+          costObject += perBin[p][b] * -std::log(object[b]);
+          costBackground += perBin[p][b] * -std::log(background[b]);
+        }
+      }
+      spanning += std::count_if(perBin[p].begin(), perBin[p].end(), [](double c) { return c > 0.0; }) > 5 ? 1 : 0;
+      flow += std::min(par.Lambda * costObject, par.Lambda * costBackground);
+    }
+    EXPECT_EQ(spanning, 48);
+    EXPECT_NEAR(serial.Flow, flow, 1e-12 * flow) << bins << " " << sortedLimit;
+  }
+}
+
 TEST(BoykovJolly, KeptCutsEqualFreshCuts)
 {
   // 60 super-nodes of 1-40 noisy voxels each (spanning several bins), object-like first; a chain of
-  // seed edits through one MaxFlowCache: a binning seen first (summed from the values), the same
-  // binning again (kept as runs), read from the runs, a seed sample beyond the range (a new binning),
+  // seed edits through one MaxFlowCache, with the values sorted and bounded: a binning seen first
+  // (summed from the sorted values, or binned from the voxels), the same binning again (kept as
+  // runs), read from the runs, a seed sample beyond the range (a new binning),
   // then a change of the bins and of sigma (new weights). Each cut equals a fresh one: the same
   // labels and flow.
   std::mt19937 rng(11);
@@ -768,39 +874,42 @@ TEST(BoykovJolly, KeptCutsEqualFreshCuts)
     }
     mean.push_back(sum / c);
   }
-  CutProblem pr = SeededChain(mean);
-  NodeVoxelValues grouped;
-  std::string error;
-  ASSERT_TRUE(GroupVoxelValues(owner.data(), voxels.data(), static_cast<std::int64_t>(voxels.size()), 60, grouped,
-    error, SerialFor()));
-  pr.NodeVoxels = &grouped;
-  BoykovJollyParameters par;
-  par.Lambda = 1.0;
-  const std::vector<std::vector<double>> objectSamples = { { 20, 22, 18, 25 }, { 20, 22, 18, 25 }, { 21, 19, 23, 17 },
-    { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 } };
-  // Edits 0-3 on held (owned) edge lists, which the cache keeps as they are; from 4 on a view of
-  // equal lists (compared by value: the kept flow still applies), which the new sigma of edit 6
-  // makes the cache copy, and edit 7 reuses.
-  const std::vector<std::int64_t> A(pr.Edges.First(), pr.Edges.First() + pr.Edges.Size());
-  const std::vector<std::int64_t> B(pr.Edges.Second(), pr.Edges.Second() + pr.Edges.Size());
-  MaxFlowCache cache;
-  for (size_t edit = 0; edit < objectSamples.size(); ++edit)
+  for (const std::int64_t sortedLimit : { SortedVoxelLimit, std::int64_t(0) })
   {
-    if (edit == 4)
+    CutProblem pr = SeededChain(mean);
+    NodeVoxelValues grouped;
+    std::string error;
+    ASSERT_TRUE(GroupVoxelValues(owner.data(), voxels.data(), static_cast<std::int64_t>(voxels.size()), 60, grouped,
+      error, SerialFor(), NoProgress(), nullptr, sortedLimit));
+    pr.NodeVoxels = &grouped;
+    BoykovJollyParameters par;
+    par.Lambda = 1.0;
+    const std::vector<std::vector<double>> objectSamples = { { 20, 22, 18, 25 }, { 20, 22, 18, 25 }, { 21, 19, 23, 17 },
+      { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 } };
+    // Edits 0-3 on held (owned) edge lists, which the cache keeps as they are; from 4 on a view of
+    // equal lists (compared by value: the kept flow still applies), which the new sigma of edit 6
+    // makes the cache copy, and edit 7 reuses.
+    const std::vector<std::int64_t> A(pr.Edges.First(), pr.Edges.First() + pr.Edges.Size());
+    const std::vector<std::int64_t> B(pr.Edges.Second(), pr.Edges.Second() + pr.Edges.Size());
+    MaxFlowCache cache;
+    for (size_t edit = 0; edit < objectSamples.size(); ++edit)
     {
-      pr.Edges = GraphEdges(A, B);
+      if (edit == 4)
+      {
+        pr.Edges = GraphEdges(A, B);
+      }
+      pr.ObjectSamples = objectSamples[edit];
+      pr.BackgroundSamples = { 5, 3, 7, 4 + static_cast<double>(edit) };
+      par.Bins = edit >= 5 ? 16 : 0;
+      par.Sigma = edit >= 6 ? 2.0 : 0.0;
+      const CutResult kept = BoykovJollyCut(pr, par, NoProgress(), &cache);
+      const CutResult fresh = BoykovJollyCut(pr, par);
+      ASSERT_TRUE(kept.Error.empty() && fresh.Error.empty()) << edit;
+      EXPECT_EQ(kept.Label, fresh.Label) << edit;
+      EXPECT_NEAR(kept.Flow, fresh.Flow, 1e-12 * fresh.Flow) << edit;
+      const auto object = std::count(kept.Label.begin(), kept.Label.end(), 1);
+      EXPECT_TRUE(object >= 22 && object <= 28) << edit << ": " << object;
     }
-    pr.ObjectSamples = objectSamples[edit];
-    pr.BackgroundSamples = { 5, 3, 7, 4 + static_cast<double>(edit) };
-    par.Bins = edit >= 5 ? 16 : 0;
-    par.Sigma = edit >= 6 ? 2.0 : 0.0;
-    const CutResult kept = BoykovJollyCut(pr, par, NoProgress(), &cache);
-    const CutResult fresh = BoykovJollyCut(pr, par);
-    ASSERT_TRUE(kept.Error.empty() && fresh.Error.empty()) << edit;
-    EXPECT_EQ(kept.Label, fresh.Label) << edit;
-    EXPECT_NEAR(kept.Flow, fresh.Flow, 1e-12 * fresh.Flow) << edit;
-    const auto object = std::count(kept.Label.begin(), kept.Label.end(), 1);
-    EXPECT_TRUE(object >= 22 && object <= 28) << edit << ": " << object;
   }
 }
 
