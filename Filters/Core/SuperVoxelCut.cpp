@@ -165,9 +165,16 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
         if (pr.Hard[e])
         {
           std::vector<double>& samples = pr.Hard[e] == 1 ? pr.ObjectSamples : pr.BackgroundSamples;
-          const std::size_t first = samples.size();
-          ElementVoxelValues(mesh, owner, grouped, e, samples);
-          std::sort(samples.begin() + static_cast<std::ptrdiff_t>(first), samples.end());
+          if (grouped.Sorted())
+          {
+            grouped.Visit([&](const auto* all) { samples.insert(samples.end(), all + grouped.Offset[e], all + grouped.Offset[e + 1]); });
+          }
+          else
+          {
+            const std::size_t first = samples.size();
+            ElementVoxelValues(mesh, owner, grouped, e, samples);
+            std::sort(samples.begin() + static_cast<std::ptrdiff_t>(first), samples.end());
+          }
         }
       }
     }
