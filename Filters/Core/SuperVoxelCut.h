@@ -82,16 +82,17 @@ bool PrepareVoxelOwners(const SimplexMesh& mesh, SuperVoxelCutData& data, const 
   const ProgressFunction& progress = NoProgress());
 
 // The owners, and `voxelValues` (optional, one per voxel of the mesh's image, in the image's own type)
-// grouped by element (BoykovJolly.h); `keep` (optional) keeps the values alive. False with a sentence for a bad value,
-// without one when progress asked to abort.
+// grouped by element (BoykovJolly.h, sorted up to `sortedLimit` voxels); `keep` (optional) keeps the
+// values alive. False with a sentence for a bad value, without one when progress asked to abort.
 template <typename T>
 bool PrepareSuperVoxelCut(const SimplexMesh& mesh, const T* voxelValues, SuperVoxelCutData& data, std::string& error,
-  const ParallelFor& parallel, const ProgressFunction& progress = NoProgress(), std::shared_ptr<const void> keep = nullptr)
+  const ParallelFor& parallel, const ProgressFunction& progress = NoProgress(), std::shared_ptr<const void> keep = nullptr,
+  std::int64_t sortedLimit = SortedVoxelLimit)
 {
   return PrepareVoxelOwners(mesh, data, parallel, SubProgress(progress, 0.0, voxelValues ? 0.6 : 1.0)) &&
     (!voxelValues ||
       GroupVoxelValues(data.Owner.data(), voxelValues, mesh.Geometry().Size(), mesh.NumberOfElements(), data.Voxels,
-        error, parallel, SubProgress(progress, 0.6, 1.0), std::move(keep)));
+        error, parallel, SubProgress(progress, 0.6, 1.0), std::move(keep), sortedLimit));
 }
 
 // A voxel's value by index (the image, however it is stored).
