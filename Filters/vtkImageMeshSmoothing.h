@@ -10,7 +10,8 @@
  * Delaunay refinement then adds nodes where the angle bounds are missed (2D CGAL, 3D TetGen with
  * the box faces kept), and 3D meshes finish with sliver perturbation. Fixed nodes (point array Fixed = 1) never move; free
  * nodes on the image box slide in their face or edge; box corners stay. The output has the same
- * points (moved) and point arrays, new elements, and stage 2's cell arrays recomputed exactly.
+ * points (moved) and point arrays, new elements, and stage 2's cell arrays recomputed exactly, with
+ * its own voxel owner map; it asks its input for none (docs/CONTRACT.md).
  * See Filters/Core/MeshSmoothing.h.
  */
 #ifndef vtkImageMeshSmoothing_h
