@@ -174,7 +174,10 @@ bool SortByNode(const std::int32_t* owner, const T* values, std::int64_t voxels,
       {
         const double x = static_cast<double>(values[v]);
         bad += std::isfinite(x) && std::fabs(x) <= 1e150 ? 0 : 1;
-        count[owner[v]] += owner[v] >= 0 ? 1 : 0;
+        if (owner[v] >= 0)
+        {
+          ++count[owner[v]];
+        }
       }
       badPerChunk[c] = bad;
     }
