@@ -220,7 +220,7 @@ int vtkDelaunayImageMesh::RequestData(
     t0 = Clock::now();
     const ParallelFor parallel = SMPParallelFor();
     const SimplexMesh mesh(geometry, std::move(index), std::move(delaunay.Cells), delaunay.VerticesPerCell);
-    const vtkSmartPointer<vtkIntArray> owner = VoxelOwnersWanted(outputVector) ? NewVoxelOwnerArray(geometry.Size()) : nullptr;
+    const vtkSmartPointer<vtkIntArray> owner = NewVoxelOwnerArray(outputVector, geometry.Size());
     const ElementStatistics stats = ImageElementStatistics(ElementRasterizer(mesh), values, parallel,
       AlgorithmProgress(this, 0.5, 0.9), owner ? owner->GetPointer(0) : nullptr);
     if (stats.Aborted)
@@ -232,10 +232,7 @@ int vtkDelaunayImageMesh::RequestData(
     const double statisticsSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
     this->UpdateProgress(0.9);
     WriteImageMesh(mesh, stats, minAngle, radiusRatio, output);
-    if (owner)
-    {
-      AttachVoxelOwners(output, owner);
-    }
+    AttachVoxelOwners(output, owner);
 
     // Node arrays pass through; added nodes get NodeType Added and Fixed 1 (corners) or 0 (refinement).
     const vtkIdType nPts = mesh.NumberOfPoints();

@@ -539,8 +539,13 @@ const float* FloatValues(vtkDataArray* array, std::vector<float>& storage, std::
   return ToFloat(array, storage, error) ? storage.data() : nullptr;
 }
 
-vtkSmartPointer<vtkIntArray> NewVoxelOwnerArray(std::int64_t voxels)
+vtkSmartPointer<vtkIntArray> NewVoxelOwnerArray(vtkInformationVector* outputVector, std::int64_t voxels)
 {
+  vtkInformation* info = outputVector->GetInformationObject(0);
+  if (info->Has(VoxelOwnersRequest()) && info->Get(VoxelOwnersRequest()) == 0)
+  {
+    return nullptr;
+  }
   auto owner = vtkSmartPointer<vtkIntArray>::New();
   owner->SetName(names::VoxelOwner);
   owner->SetNumberOfTuples(static_cast<vtkIdType>(voxels));
@@ -584,6 +589,10 @@ std::uint64_t MeshDigest(vtkUnstructuredGrid* grid)
 
 void AttachVoxelOwners(vtkUnstructuredGrid* mesh, vtkIntArray* owner)
 {
+  if (!owner)
+  {
+    return;
+  }
   mesh->GetFieldData()->AddArray(owner);
   vtkNew<vtkTypeUInt64Array> digest;
   digest->SetName(names::VoxelOwnerDigest);
@@ -632,11 +641,6 @@ void StopVoxelOwnersRequest(vtkInformationVector* portVector)
   }
 }
 
-bool VoxelOwnersWanted(vtkInformationVector* outputVector)
-{
-  vtkInformation* info = outputVector->GetInformationObject(0);
-  return !info->Has(VoxelOwnersRequest()) || info->Get(VoxelOwnersRequest()) != 0;
-}
 
 void DropVoxelOwners(vtkDataObject* object)
 {

@@ -136,8 +136,10 @@ void WriteImageMesh(const SimplexMesh& mesh, const ElementStatistics& statistics
   const std::vector<double>& radiusRatio, vtkUnstructuredGrid* output);
 
 // The owner map of stages 2 and 3 (Contract.h, VoxelOwner): a fresh array of `voxels` tuples to fill
-// (ComputeElementStatistics), attached to the written mesh with the digest of its points and cells.
-vtkSmartPointer<vtkIntArray> NewVoxelOwnerArray(std::int64_t voxels);
+// (ComputeElementStatistics), or null when the consumers of `outputVector`'s port 0 asked for none
+// (VoxelOwnersRequest); attached (when not null) to the written mesh with the digest of its points
+// and cells.
+vtkSmartPointer<vtkIntArray> NewVoxelOwnerArray(vtkInformationVector* outputVector, std::int64_t voxels);
 void AttachVoxelOwners(vtkUnstructuredGrid* mesh, vtkIntArray* owner);
 // The owner map attached to `mesh` when it has `voxels` tuples and was made for the mesh's points and
 // cells as they are now; else false (the caller rasterises).
@@ -154,8 +156,6 @@ vtkInformationIntegerRequestKey* VoxelOwnersRequest();
 void RequestNoVoxelOwners(vtkInformationVector* portVector);
 // Removes the request from every input connected to `port` (called in RequestUpdateExtent).
 void StopVoxelOwnersRequest(vtkInformationVector* portVector);
-// Whether the consumers of `outputVector`'s port 0 want the owner map.
-bool VoxelOwnersWanted(vtkInformationVector* outputVector);
 // Removes the owner map from a copy that is no longer an image mesh (a labelled mesh, a moved one).
 void DropVoxelOwners(vtkDataObject* object);
 // A 64-bit digest of a grid's points and cells as stored.

@@ -163,7 +163,7 @@ int vtkImageMeshSmoothing::RequestData(
     std::vector<float>().swap(floatStorage); // the statistics read the array in its own type
 
     t0 = Clock::now();
-    const vtkSmartPointer<vtkIntArray> owner = VoxelOwnersWanted(outputVector) ? NewVoxelOwnerArray(geometry.Size()) : nullptr;
+    const vtkSmartPointer<vtkIntArray> owner = NewVoxelOwnerArray(outputVector, geometry.Size());
     const ElementStatistics stats = ImageElementStatistics(ElementRasterizer(result.Mesh), array, parallel,
       AlgorithmProgress(this, 0.6, 0.95), owner ? owner->GetPointer(0) : nullptr);
     if (stats.Aborted)
@@ -174,10 +174,7 @@ int vtkImageMeshSmoothing::RequestData(
     this->UpdateProgress(0.97);
     const double statisticsSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
     WriteImageMesh(result.Mesh, stats, minAngle, radiusRatio, output);
-    if (owner)
-    {
-      AttachVoxelOwners(output, owner);
-    }
+    AttachVoxelOwners(output, owner);
     PassNodeArrays(input->GetPointData(), nPts, output->GetPointData(), result.Mesh.NumberOfPoints(), nPts);
     const bool is2D = geometry.Is2D();
     AddFieldValue(output, is2D ? names::MinAngleBefore : names::MinDihedralAngleBefore, before);

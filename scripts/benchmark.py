@@ -212,8 +212,7 @@ def main():
         report.use_huge_pages(sys.argv)
     args.lambdas = [float(v) for v in args.lambdas.split(",") if v]
     fm.load_plugin()
-    selection = [c for c in args.cases.split(",") if c]
-    found = fm.cases(selection)
+    found = fm.cases(args.cases)
     if not os.path.isdir(os.path.join(fm.SHARED, "cases")):
         print("shared data not found at %s: only the bundled cases run" % fm.SHARED)
     rows, lam_rows = [], []

@@ -105,9 +105,8 @@ def main():
     ap.add_argument("--out", default=os.path.join(fm.ROOT, "out", "benchmark_rsp"))
     args = ap.parse_args()
     fm.load_plugin()
-    selection = [c for c in args.cases.split(",") if c]
     rows = []
-    for name, folder in fm.cases(selection).items():
+    for name, folder in fm.cases(args.cases).items():
         if not os.path.isfile(os.path.join(folder, "truth.mha")):
             continue
         rows.append(run_case(fm.Case(folder), args))

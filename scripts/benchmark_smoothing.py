@@ -58,7 +58,7 @@ def main():
     props = parse(args.smoothing)
     fm.load_plugin()
     rows = []
-    for name, d in fm.cases([c for c in args.cases.split(",") if c]).items():
+    for name, d in fm.cases(args.cases).items():
         case = fm.Case(d)
         T = case.truth()
         if T is None:

@@ -43,7 +43,7 @@ def main():
     args = ap.parse_args()
     fm.load_plugin()
     rows = []
-    for name, folder in fm.cases([c for c in args.cases.split(",") if c]).items():
+    for name, folder in fm.cases(args.cases).items():
         case = fm.Case(folder)
         truth = case.truth()
         if truth is None or not case.is3d:

@@ -52,7 +52,7 @@ def main():
     cut_properties = {k: int(v) if v.isdigit() else float(v) for k, v in (p.split("=") for p in args.cut.split(",") if p)}
     fm.load_plugin()
     lines = []
-    for name, d in fm.cases([c for c in args.cases.split(",") if c]).items():
+    for name, d in fm.cases(args.cases).items():
         case = fm.Case(d)
         nodes = case.feature_nodes()
         n = fm.fetch(nodes)

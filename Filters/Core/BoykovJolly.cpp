@@ -18,6 +18,19 @@ namespace featuremesh
 {
 namespace
 {
+// Values whose squares and sums stay finite in double precision.
+constexpr double LargestIntensity = 1e150;
+
+bool Usable(double v)
+{
+  return std::isfinite(v) && std::fabs(v) <= LargestIntensity;
+}
+
+std::string UnusableIntensities(std::int64_t count)
+{
+  return std::to_string(count) + " intensities are NaN, infinite or beyond +-1e150; replace or rescale them (e.g. with a Calculator) first.";
+}
+
 // Percentile of at most ~1 M evenly strided values: exact enough for a histogram range, and a
 // 9 M-voxel volume is not copied and partially sorted twice.
 template <typename T>
@@ -173,7 +186,7 @@ bool SortByNode(const std::int32_t* owner, const T* values, std::int64_t voxels,
       for (std::int64_t v = c * size, e = std::min(voxels, (c + 1) * size); v < e; ++v)
       {
         const double x = static_cast<double>(values[v]);
-        bad += std::isfinite(x) && std::fabs(x) <= 1e150 ? 0 : 1;
+        bad += Usable(x) ? 0 : 1;
         if (owner[v] >= 0)
         {
           ++count[owner[v]];
@@ -185,7 +198,7 @@ bool SortByNode(const std::int32_t* owner, const T* values, std::int64_t voxels,
   const std::int64_t bad = std::accumulate(badPerChunk.begin(), badPerChunk.end(), std::int64_t(0));
   if (bad)
   {
-    error = std::to_string(bad) + " intensities are NaN, infinite or beyond +-1e150; replace or rescale them (e.g. with a Calculator) first.";
+    error = UnusableIntensities(bad);
     return false;
   }
   if (!progress(0.3))
@@ -265,7 +278,7 @@ bool BoundByNode(const std::int32_t* owner, const T* values, std::int64_t voxels
       for (std::int64_t v = c * size, e = std::min(voxels, (c + 1) * size); v < e; ++v)
       {
         const double x = static_cast<double>(values[v]);
-        bad += std::isfinite(x) && std::fabs(x) <= 1e150 ? 0 : 1;
+        bad += Usable(x) ? 0 : 1;
         const std::int32_t p = owner[v];
         if (p >= 0)
         {
@@ -289,7 +302,7 @@ bool BoundByNode(const std::int32_t* owner, const T* values, std::int64_t voxels
   const std::int64_t bad = std::accumulate(badPerChunk.begin(), badPerChunk.end(), std::int64_t(0));
   if (bad)
   {
-    error = std::to_string(bad) + " intensities are NaN, infinite or beyond +-1e150; replace or rescale them (e.g. with a Calculator) first.";
+    error = UnusableIntensities(bad);
     return false;
   }
   AssignFresh(grouped.Min, static_cast<std::size_t>(nodes));
@@ -374,14 +387,6 @@ void ThrowOutOfMemory(const char* what)
 // on fresh memory.
 constexpr std::int64_t CheckEvery = (std::int64_t(1) << 18) - 1;
 
-// Values whose squares and sums stay finite in double precision.
-constexpr double LargestIntensity = 1e150;
-
-bool Usable(double v)
-{
-  return std::isfinite(v) && std::fabs(v) <= LargestIntensity;
-}
-
 // Empty when every input of the energy is usable, else a sentence.
 std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progress, bool& aborted)
 {
@@ -427,7 +432,7 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
   }
   if (badValue)
   {
-    return std::to_string(badValue) + " intensities are NaN, infinite or beyond +-1e150; replace or rescale them (e.g. with a Calculator) first.";
+    return UnusableIntensities(badValue);
   }
   if (badSize)
   {
@@ -608,27 +613,23 @@ bool BinBoundedVoxels(const NodeVoxelValues& voxels, const HistogramBins& bin, M
   const std::int64_t n = voxels.Nodes;
   std::vector<std::int64_t>& offset = binned.Offset;
   AssignFresh(offset, static_cast<std::size_t>(n + 1), std::int64_t(0));
-  std::vector<int> first(static_cast<std::size_t>(n));
-  for (std::int64_t p = 0; p < n; ++p)
-  {
-    const bool any = voxels.Min[p] <= voxels.Max[p];
-    first[p] = any ? bin(voxels.Min[p]) : 0;
-    offset[p + 1] = offset[p] + (any ? bin(voxels.Max[p]) - first[p] + 1 : 0);
-  }
-  AssignFresh(binned.Bin, static_cast<std::size_t>(offset[n]));
-  AssignFresh(binned.Count, static_cast<std::size_t>(offset[n]), std::uint32_t(0));
-  // Voxel v of node p counts at base[p] + bin(value).
+  // Voxel v of node p counts at base[p] + bin(value): node p's runs are its bins from bin(Min[p]).
   std::vector<std::int64_t> base(static_cast<std::size_t>(n));
   for (std::int64_t p = 0; p < n; ++p)
   {
-    base[p] = offset[p] - first[p];
+    const bool any = voxels.Min[p] <= voxels.Max[p];
+    const int first = any ? bin(voxels.Min[p]) : 0;
+    base[p] = offset[p] - first;
+    offset[p + 1] = offset[p] + (any ? bin(voxels.Max[p]) - first + 1 : 0);
   }
+  AssignFresh(binned.Bin, static_cast<std::size_t>(offset[n]));
+  AssignFresh(binned.Count, static_cast<std::size_t>(offset[n]), std::uint32_t(0));
   parallel(n, 65536, [&](std::int64_t p0, std::int64_t p1) {
     for (std::int64_t p = p0; p < p1; ++p)
     {
       for (std::int64_t k = offset[p]; k < offset[p + 1]; ++k)
       {
-        binned.Bin[k] = static_cast<std::uint16_t>(first[p] + (k - offset[p]));
+        binned.Bin[k] = static_cast<std::uint16_t>(k - base[p]);
       }
     }
   });

@@ -50,7 +50,10 @@ def load_plugin(path=None, ns=None):
 
 
 def cases(selection=()):
-    """{name: folder} of the bundled cases, then those of the shared data; `selection` filters by name."""
+    """{name: folder} of the bundled cases, then those of the shared data; `selection` (names, or a
+    comma-separated string as the scripts' --cases take it) filters by name."""
+    if isinstance(selection, str):
+        selection = [c for c in selection.split(",") if c]
     found = {}
     for root in (DATA, os.path.join(SHARED, "cases")):
         for image in sorted(glob.glob(os.path.join(root, "*", "image.mha"))):
