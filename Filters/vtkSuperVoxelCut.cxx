@@ -61,7 +61,10 @@ vtkSuperVoxelCut::vtkSuperVoxelCut()
   this->Bins = defaults.Bins;
   this->Sigma = defaults.Sigma;
   this->Lambda = defaults.Lambda;
+  this->Task = static_cast<int>(defaults.Task);
   this->Connectivity = static_cast<int>(defaults.Connectivity);
+  this->GeodesicWeight = defaults.Geodesic.Weight;
+  this->GeodesicLength = defaults.Geodesic.LengthWeight;
   this->Bandwidth = defaults.Bandwidth;
   this->ScaleByContact = defaults.ScaleByContact;
   this->VoxelRegionTerm = defaults.VoxelRegionTerm;
@@ -142,7 +145,10 @@ int vtkSuperVoxelCut::RequestData(
     par.Bins = this->Bins;
     par.Sigma = this->Sigma;
     par.Lambda = this->Lambda;
+    par.Task = static_cast<featuremesh::Task>(this->Task);
     par.Connectivity = static_cast<featuremesh::Connectivity>(this->Connectivity);
+    par.Geodesic.Weight = this->GeodesicWeight;
+    par.Geodesic.LengthWeight = this->GeodesicLength;
     par.Bandwidth = this->Bandwidth;
     par.ScaleByContact = this->ScaleByContact;
     par.VoxelRegionTerm = this->VoxelRegionTerm;
@@ -322,6 +328,7 @@ int vtkSuperVoxelCut::RequestData(
       AddFieldValue(d, names::SetupSeconds, result.SetupSeconds);
       AddFieldValue(d, names::GraphSeconds, cut.GraphSeconds);
       AddFieldValue(d, names::FlowSeconds, cut.FlowSeconds);
+      AddFieldValue(d, names::GeodesicSeconds, cut.GeodesicSeconds);
       AddFieldValue(d, names::CutTotalSeconds, std::chrono::duration<double>(Clock::now() - start).count());
     }
     this->UpdateProgress(1.0);
@@ -335,7 +342,10 @@ void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Bins: " << this->Bins << "\n"
      << indent << "Sigma: " << this->Sigma << "\n"
      << indent << "Lambda: " << this->Lambda << "\n"
+     << indent << "Task: " << this->Task << "\n"
      << indent << "Connectivity: " << this->Connectivity << "\n"
+     << indent << "GeodesicWeight: " << this->GeodesicWeight << "\n"
+     << indent << "GeodesicLength: " << this->GeodesicLength << "\n"
      << indent << "Bandwidth: " << this->Bandwidth << "\n"
      << indent << "SuperVoxelIds: " << this->SuperVoxelIds << "\n"
      << indent << "ScaleByContact: " << this->ScaleByContact << "\n"

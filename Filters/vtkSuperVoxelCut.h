@@ -37,9 +37,20 @@ public:
   /// Region-term weight lambda.
   vtkSetMacro(Lambda, double);
   vtkGetMacro(Lambda, double);
-  /// What the seeds reach (featuremesh::Connectivity): 0 off, 1 fill holes, 2 one seeded object.
-  vtkSetClampMacro(Connectivity, int, 0, 2);
+  /// What the seeds ask for (featuremesh::Task): 0 the one object they lie in (default), 1 every
+  /// object like the seeded ones. Out of range: an error at execution.
+  vtkSetMacro(Task, int);
+  vtkGetMacro(Task, int);
+  /// What the seeds reach (featuremesh::Connectivity): 0 off, 1 fill holes, 2 one seeded object,
+  /// 3 from the task (default: 2 for Object, 1 for Class).
+  vtkSetClampMacro(Connectivity, int, 0, 3);
   vtkGetMacro(Connectivity, int);
+  /// Weight of the seeds' geodesic spatial term for Task Object (featuremesh::SeedGeodesicParameters); 0 = off.
+  vtkSetMacro(GeodesicWeight, double);
+  vtkGetMacro(GeodesicWeight, double);
+  /// Length of a voxel of travel in the geodesic, in units of the intensity range.
+  vtkSetMacro(GeodesicLength, double);
+  vtkGetMacro(GeodesicLength, double);
   /// Kernel bandwidth of the seed histograms as a multiple of Silverman's rule (default 1).
   vtkSetMacro(Bandwidth, double);
   vtkGetMacro(Bandwidth, double);
@@ -79,7 +90,10 @@ protected:
   int Bins;
   double Sigma;
   double Lambda;
+  int Task;
   int Connectivity;
+  double GeodesicWeight;
+  double GeodesicLength;
   double Bandwidth;
   bool ScaleByContact;
   bool VoxelRegionTerm;

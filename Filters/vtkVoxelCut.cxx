@@ -28,7 +28,10 @@ vtkVoxelCut::vtkVoxelCut()
   this->Bins = defaults.Bins;
   this->Sigma = defaults.Sigma;
   this->Lambda = defaults.Lambda;
+  this->Task = static_cast<int>(defaults.Task);
   this->Connectivity = static_cast<int>(defaults.Connectivity);
+  this->GeodesicWeight = defaults.Geodesic.Weight;
+  this->GeodesicLength = defaults.Geodesic.LengthWeight;
   this->Bandwidth = defaults.Bandwidth;
   this->SeedRadius = defaults.SeedRadius;
   this->SetNumberOfInputPorts(3);
@@ -86,7 +89,10 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     par.Bins = this->Bins;
     par.Sigma = this->Sigma;
     par.Lambda = this->Lambda;
+    par.Task = static_cast<featuremesh::Task>(this->Task);
     par.Connectivity = static_cast<featuremesh::Connectivity>(this->Connectivity);
+    par.Geodesic.Weight = this->GeodesicWeight;
+    par.Geodesic.LengthWeight = this->GeodesicLength;
     par.Bandwidth = this->Bandwidth;
     par.SeedRadius = this->SeedRadius;
     error = ValidateParameters(par);
@@ -131,6 +137,7 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     AddFieldValue(output, names::Flow, cut.Flow);
     AddFieldValue(output, names::GraphSeconds, cut.GraphSeconds);
     AddFieldValue(output, names::FlowSeconds, cut.FlowSeconds);
+    AddFieldValue(output, names::GeodesicSeconds, cut.GeodesicSeconds);
     AddObjectComponents(output, cut.ObjectComponentVoxels, geometry.VoxelVolume(), cut.ConnectivityChanged);
     AddFieldValue(output, names::TotalSeconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     this->UpdateProgress(1.0);
@@ -144,7 +151,10 @@ void vtkVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Bins: " << this->Bins << "\n"
      << indent << "Sigma: " << this->Sigma << "\n"
      << indent << "Lambda: " << this->Lambda << "\n"
+     << indent << "Task: " << this->Task << "\n"
      << indent << "Connectivity: " << this->Connectivity << "\n"
+     << indent << "GeodesicWeight: " << this->GeodesicWeight << "\n"
+     << indent << "GeodesicLength: " << this->GeodesicLength << "\n"
      << indent << "Bandwidth: " << this->Bandwidth << "\n"
      << indent << "SeedRadius: " << this->SeedRadius << "\n";
 }

@@ -398,6 +398,7 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
     static_cast<std::int64_t>(pr.Hard.size()) != n || edges.Malformed() ||
     (edges.IsGrid() && static_cast<std::int64_t>(dims[0]) * dims[1] * dims[2] != n) ||
     (!pr.Contact.empty() && static_cast<std::int64_t>(pr.Contact.size()) != m) ||
+    (!pr.Step.empty() && static_cast<std::int64_t>(pr.Step.size()) != m) ||
     (pr.NodeVoxels && (pr.NodeVoxels->Nodes != n || pr.NodeVoxels->Empty())))
   {
     return "the graph's arrays disagree in length.";
@@ -414,7 +415,8 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
   // Grid edges are valid by construction.
   const auto checkEdge = [&](std::int64_t e, std::int64_t a, std::int64_t b) {
     badEdge += (a >= 0 && a < n && b >= 0 && b < n &&
-                 (pr.Contact.empty() || (std::isfinite(pr.Contact[e]) && pr.Contact[e] >= 0.0)))
+                 (pr.Contact.empty() || (std::isfinite(pr.Contact[e]) && pr.Contact[e] >= 0.0)) &&
+                 (pr.Step.empty() || (std::isfinite(pr.Step[e]) && pr.Step[e] >= 0.0)))
       ? 0
       : 1;
   };
@@ -440,7 +442,7 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
   }
   if (badEdge)
   {
-    return std::to_string(badEdge) + " graph edges name missing nodes or have a negative or non-finite contact.";
+    return std::to_string(badEdge) + " graph edges name missing nodes or have a negative or non-finite contact or length.";
   }
   return std::string();
 }
@@ -891,12 +893,36 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
       }
     }
   }
+  if (pr.Geodesic.Weight > 0.0)
+  {
+    // The seeds' spatial term: it moves terminal capacities only, so a kept flow still applies.
+    const auto g0 = Clock::now();
+    GeodesicGraph graph;
+    graph.Edges = &edges;
+    graph.Value = pr.Value.data();
+    graph.Nodes = n;
+    graph.Step = &pr.Step;
+    std::vector<double> spatialObject, spatialBackground;
+    if (!SeedGeodesicCosts(graph, pr.Hard, high - low, pr.Geodesic, pr.Parallel, spatialObject, spatialBackground,
+          SubProgress(progress, 0.3, 0.33)))
+    {
+      r.Aborted = true;
+      return r;
+    }
+    for (std::int64_t p = 0; p < static_cast<std::int64_t>(spatialObject.size()); ++p)
+    {
+      const double size = pr.Size.empty() ? 1.0 : pr.Size[p];
+      regionObject[p] += size * spatialObject[p];
+      regionBackground[p] += size * spatialBackground[p];
+    }
+    r.GeodesicSeconds = std::chrono::duration<double>(Clock::now() - g0).count();
+  }
   for (std::int64_t p = 0; p < n; ++p)
   {
     regionObject[p] *= par.Lambda;
     regionBackground[p] *= par.Lambda;
     total += std::max(regionObject[p], regionBackground[p]);
-    if (aborted(p, n, 0.3, 0.35))
+    if (aborted(p, n, 0.33, 0.35))
     {
       return r;
     }

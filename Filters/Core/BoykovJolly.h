@@ -14,6 +14,7 @@
 
 #include "GraphEdges.h"
 #include "Parallel.h"
+#include "SeedGeodesics.h"
 
 #include <cstdint>
 #include <memory>
@@ -99,6 +100,10 @@ struct CutProblem
   // over its voxel values x of -ln Pr(x | L) instead of Size_p * -ln Pr(Value_p | L). A mixed
   // element then costs what its voxels would cost in the voxel cut, rather than what its mean would.
   const NodeVoxelValues* NodeVoxels = nullptr;
+  // The seeds' spatial term (SeedGeodesics.h), per voxel of each node; Weight 0 = off. Step: the
+  // length of each explicit edge in voxels (empty: 1 each, the voxel grid).
+  SeedGeodesicParameters Geodesic{ 0.0 };
+  std::vector<double> Step;
   // How loops over nodes may split across threads.
   ParallelFor Parallel = SerialFor();
 };
@@ -109,7 +114,7 @@ struct CutResult
   double Flow = 0.0;
   double Sigma = 0.0;
   int Bins = 0;
-  double GraphSeconds = 0.0, FlowSeconds = 0.0;
+  double GraphSeconds = 0.0, FlowSeconds = 0.0, GeodesicSeconds = 0.0;
   // Filled by the cuts after their connectivity rule: nodes the rule relabelled, and the object
   // components' sizes in voxels, largest first.
   std::int64_t ConnectivityChanged = 0;

@@ -115,6 +115,7 @@ constexpr const char* ConnectivityChanged = "ConnectivityChanged"; // nodes the 
 constexpr const char* SetupSeconds = "SetupSeconds";
 constexpr const char* GraphSeconds = "GraphSeconds";
 constexpr const char* FlowSeconds = "FlowSeconds";
+constexpr const char* GeodesicSeconds = "GeodesicSeconds"; // the seeds' spatial term (Task Object)
 constexpr const char* CutTotalSeconds = "CutTotalSeconds";
 } // namespace names
 } // namespace featuremesh

@@ -21,7 +21,24 @@ enum class Connectivity : int
   // One object: object components that hold no object seed become background, then holes are
   // filled as above.
   SeededObject = 2,
+  // The task's rule: Seeded Object for Task Object, Fill Holes for Task Class.
+  FromTask = 3,
 };
+
+// What the user asks of the seeds.
+enum class Task : int
+{
+  // The one object the object seeds lie in (a tumour, an organ).
+  Object = 0,
+  // Every object that looks like the seeded ones (all nuclei, all cells, all vessels).
+  Class = 1,
+};
+
+// The rule `mode` names for `task` (FromTask resolved).
+inline Connectivity ConnectivityFor(Connectivity mode, Task task)
+{
+  return mode != Connectivity::FromTask ? mode : (task == Task::Object ? Connectivity::SeededObject : Connectivity::FillHoles);
+}
 
 // Components of equal label over the graph's edges: an id per node, numbered in order of each
 // component's first node (deterministic); `count` receives their number. Empty when `progress`

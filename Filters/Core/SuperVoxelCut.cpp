@@ -94,6 +94,32 @@ void ElementVoxelValues(const SimplexMesh& mesh, const VoxelOwnerMap& owner, con
 }
 } // namespace
 
+std::vector<double> CentreDistances(const SimplexMesh& mesh, const FaceAdjacency& adj)
+{
+  const std::int64_t m = mesh.NumberOfElements();
+  const int k = mesh.VerticesPerCell();
+  std::vector<std::array<double, 3>> centre(m, { { 0.0, 0.0, 0.0 } });
+  for (std::int64_t e = 0; e < m; ++e)
+  {
+    for (int v = 0; v < k; ++v)
+    {
+      const auto& q = mesh.Points()[mesh.Cell(e)[v]];
+      for (int a = 0; a < 3; ++a)
+      {
+        centre[e][a] += q[a] / k;
+      }
+    }
+  }
+  std::vector<double> step(adj.A.size());
+  for (std::size_t f = 0; f < step.size(); ++f)
+  {
+    const auto& a = centre[adj.A[f]];
+    const auto& b = centre[adj.B[f]];
+    step[f] = std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+  }
+  return step;
+}
+
 std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale)
 {
   const FaceAdjacency& adj = mesh.Faces();
@@ -199,6 +225,11 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
       }
     }
   }
+  if (parameters.Task == Task::Object)
+  {
+    pr.Geodesic = parameters.Geodesic;
+    pr.Step = CentreDistances(mesh, adj);
+  }
   result.SetupSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
   result.Cut = BoykovJollyCut(pr, parameters, progress, flow);
   result.Aborted = result.Cut.Aborted;
@@ -212,7 +243,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   {
     border[e] = 1;
   }
-  result.Cut.ConnectivityChanged = ApplyConnectivity(parameters.Connectivity, result.Cut.Label, pr.Edges, pr.Hard,
+  result.Cut.ConnectivityChanged = ApplyConnectivity(ConnectivityFor(parameters.Connectivity, parameters.Task), result.Cut.Label, pr.Edges, pr.Hard,
     border, NoProgress(), &result.Cut.ObjectComponentVoxels, voxelCount);
   result.BoundaryFaces = LabelBoundaryFaces(mesh, adj, result.Cut.Label);
   return result;
@@ -235,6 +266,18 @@ std::string ValidateParameters(const SeededCutParameters& p)
   if (error.empty() && !(p.SeedRadius >= 0.0 && p.SeedRadius <= 50.0))
   {
     error = "the seed radius must lie in [0, 50] voxels.";
+  }
+  if (error.empty() && p.Task != Task::Object && p.Task != Task::Class)
+  {
+    error = "the task must be 0 (Object) or 1 (Class).";
+  }
+  if (error.empty() && !(static_cast<int>(p.Connectivity) >= 0 && static_cast<int>(p.Connectivity) <= 3))
+  {
+    error = "the connectivity must be 0 (Off), 1 (Fill Holes), 2 (Seeded Object) or 3 (From Task).";
+  }
+  if (error.empty())
+  {
+    error = ValidateParameters(p.Geodesic);
   }
   return error;
 }
@@ -271,6 +314,10 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
   }
   // Voxels sharing a face: enumerated, not stored.
   pr.Edges = GraphEdges::Grid(g.Dims[0], g.Dims[1], g.Dims[2]);
+  if (parameters.Task == Task::Object)
+  {
+    pr.Geodesic = parameters.Geodesic;
+  }
   // Size and Contact stay empty: 1 for every voxel and every voxel face.
   CutResult cut = BoykovJollyCut(pr, parameters, SubProgress(progress, 0.1, 0.95));
   if (!cut.Error.empty() || cut.Aborted || !progress(0.95))
@@ -286,7 +333,7 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
         border[g.Index(i, j, k)] = i == 0 || j == 0 || i + 1 == g.Dims[0] || j + 1 == g.Dims[1] ||
           (!g.Is2D() && (k == 0 || k + 1 == g.Dims[2]));
       }
-  cut.ConnectivityChanged = ApplyConnectivity(parameters.Connectivity, cut.Label, pr.Edges, pr.Hard, border,
+  cut.ConnectivityChanged = ApplyConnectivity(ConnectivityFor(parameters.Connectivity, parameters.Task), cut.Label, pr.Edges, pr.Hard, border,
     SubProgress(progress, 0.95, 1.0), &cut.ObjectComponentVoxels);
   if (cut.ConnectivityChanged < 0)
   {

@@ -20,8 +20,14 @@ namespace featuremesh
 // What both cuts share besides the energy.
 struct SeededCutParameters : BoykovJollyParameters
 {
-  // The rule applied to the cut's labels (SeedConnectivity.h).
-  featuremesh::Connectivity Connectivity = featuremesh::Connectivity::FillHoles;
+  // What the seeds ask for: the one object they lie in, or every object like them.
+  featuremesh::Task Task = featuremesh::Task::Object;
+  // The rule applied to the cut's labels (SeedConnectivity.h); FromTask: Seeded Object for Task
+  // Object, Fill Holes for Task Class.
+  featuremesh::Connectivity Connectivity = featuremesh::Connectivity::FromTask;
+  // The seeds' spatial term (SeedGeodesics.h), applied for Task Object: an object that looks like
+  // the seeded one elsewhere is not the one asked for. Task Class has none.
+  SeedGeodesicParameters Geodesic;
   // Radius (voxels) of the neighbourhood of each seed whose voxels build the histograms.
   double SeedRadius = 2.0;
 };
@@ -60,6 +66,10 @@ struct SuperVoxelCutResult
 bool SeedConstraints(const VoxelOwnerMap& owner, const std::vector<std::int64_t>& objectVoxels,
   const std::vector<std::int64_t>& backgroundVoxels, const char* node, std::vector<std::uint8_t>& hard,
   std::string& error);
+
+// Distance in voxels between the centroids of the two elements of each interior face: the step
+// of a geodesic across it.
+std::vector<double> CentreDistances(const SimplexMesh& mesh, const FaceAdjacency& adj);
 
 // Contact of each interior face of the mesh in voxel faces: a 2D edge in pixel lengths, a 3D face in
 // voxel-face areas; 1 everywhere when `scale` is off.

@@ -854,6 +854,64 @@ TEST(SuperVoxelCut, SeedRadiusOutOfRange)
       f->SetSeedRadius(-1);
     });
 }
+TEST(SuperVoxelCut, TaskOutOfRange)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "task"); },
+    [](vtkSuperVoxelCut* f) { f->SetTask(7); });
+}
+TEST(SuperVoxelCut, NegativeGeodesicWeight)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "geodesic weight"); },
+    [](vtkSuperVoxelCut* f) { f->SetGeodesicWeight(-1); });
+}
+TEST(SuperVoxelCut, NaNGeodesicLength)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "geodesic length"); },
+    [](vtkSuperVoxelCut* f) { f->SetGeodesicLength(NaN); });
+}
+TEST(SuperVoxelCut, ClassTaskKeepsTheSeeds)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image,
+    [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, c.image, c.object, c.background); },
+    [](vtkSuperVoxelCut* f) { f->SetTask(1); });
+}
+TEST(SuperVoxelCut, ASeedInEveryElement)
+{
+  // One seed at the centroid of every element, object where the element is bright: every node is a
+  // hard constraint and both geodesics are 0 on their seeds. Either a cut that keeps every seed or,
+  // where a centroid's voxel belongs to a neighbour of the other kind, the two-kinds error.
+  Case2D c;
+  std::vector<std::array<double, 3>> object, background;
+  vtkDataArray* mean = c.mesh->GetCellData()->GetArray("MeanIntensity");
+  double range[2];
+  mean->GetRange(range, 0);
+  for (vtkIdType e = 0; e < c.mesh->GetNumberOfCells(); ++e)
+  {
+    vtkIdType n;
+    const vtkIdType* ids;
+    c.mesh->GetCellPoints(e, n, ids);
+    std::array<double, 3> centre{ { 0, 0, 0 } };
+    for (vtkIdType k = 0; k < n; ++k)
+    {
+      double x[3];
+      c.mesh->GetPoint(ids[k], x);
+      for (int a = 0; a < 3; ++a)
+        centre[a] += x[a] / n;
+    }
+    (mean->GetComponent(e, 0) > 0.5 * (range[0] + range[1]) ? object : background).push_back(centre);
+  }
+  auto objectSeeds = Points(object), backgroundSeeds = Points(background);
+  SuperVoxelCut(c.mesh, objectSeeds, backgroundSeeds, c.image, [&](auto& cut, const CutOutputs& out) {
+    if (cut.Log->Errors.empty())
+      ExpectGoodCut(cut, out, c.image, objectSeeds, backgroundSeeds);
+    else
+      ExpectCutError(cut, out, "both");
+  });
+}
 TEST(SuperVoxelCut, SeededObjectKeepsTheSeeds)
 {
   Case2D c;
@@ -954,6 +1012,26 @@ TEST(VoxelCut, NegativeBandwidth)
   auto image = Disc();
   VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "bandwidth", out); },
     [](vtkVoxelCut* f) { f->SetBandwidth(-1); });
+}
+TEST(VoxelCut, TaskOutOfRange)
+{
+  auto image = Disc();
+  VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "task", out); },
+    [](vtkVoxelCut* f) { f->SetTask(-1); });
+}
+TEST(VoxelCut, NoBackgroundSeeds)
+{
+  auto image = Disc();
+  VoxelCut(image, ObjectSeeds(image), Points({}), [](auto& run, vtkImageData* out) { ExpectError(run, "no background seeds", out); });
+}
+TEST(VoxelCut, ClassTaskWithoutTheGeodesicTerm)
+{
+  auto image = Disc();
+  VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectGoodVoxelCut(run, out); },
+    [](vtkVoxelCut* f) {
+      f->SetTask(1);
+      f->SetGeodesicWeight(0);
+    });
 }
 TEST(VoxelCut, TinySigmaKeepsTheSeeds)
 {
