@@ -3,7 +3,8 @@
 
 usage: pvpython featuremesh_segment.py IMAGE --object-seeds CSV --background-seeds CSV [--truth LABELS]
                                        [--out DIR] [--plugin FeatureMesh.so]
-                                       [--lambda L] [--connectivity off|fill|seeded] [--sigma S] [--bins B]
+                                       [--task object|class] [--lambda L] [--connectivity task|off|fill|seeded]
+                                       [--sigma S] [--bins B]
                                        [--no-smoothing] [--rsp] [--surface-method laplacian|taubin]
                                        [--surface-iterations N] [--unit mm]
 --rsp runs RSP Edge Enhancement first and feeds its edge map to Feature Nodes (seed-aware nodes: fine
@@ -32,7 +33,8 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import featuremesh as fm  # noqa: E402
 from featuremesh import fem, metrics  # noqa: E402
 
-CONNECTIVITY = {"off": "Off", "fill": "Fill Holes", "seeded": "Seeded Object"}
+CONNECTIVITY = {"task": "From Task", "off": "Off", "fill": "Fill Holes", "seeded": "Seeded Object"}
+TASK = {"object": "Object", "class": "Class"}
 SURFACE_METHOD = {"laplacian": 0, "taubin": 1}
 
 
@@ -49,6 +51,9 @@ def main():
     ap.add_argument("--out", default="out")
     ap.add_argument("--plugin")
     cut_options = ap.add_argument_group("Super-Voxel Cut (default: the filter's own defaults)")
+    cut_options.add_argument("--task", choices=sorted(TASK),
+                             help="object: the one object the object seeds lie in (a tumour, an organ; the default); "
+                                  "class: every object like the seeded ones (all nuclei, all cells, all vessels)")
     cut_options.add_argument("--lambda", dest="lam", type=float, help="region-term weight (property Lambda)")
     cut_options.add_argument("--connectivity", choices=sorted(CONNECTIVITY),
                              help="off: the cut as it is; fill: fill background holes (several objects of a kind "
@@ -83,7 +88,8 @@ def main():
     delaunay = DelaunayImageMesh(Nodes=nodes, Image=image)
     mesh = delaunay if args.no_smoothing else ImageMeshSmoothing(Mesh=delaunay, Image=image)
     options = {name: value for name, value in (("Lambda", args.lam), ("Sigma", args.sigma), ("Bins", args.bins),
-               ("Connectivity", CONNECTIVITY.get(args.connectivity))) if value is not None}
+               ("Connectivity", CONNECTIVITY.get(args.connectivity)), ("Task", TASK.get(args.task)))
+               if value is not None}
     cut = SuperVoxelCut(Mesh=mesh, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, **options)
     stages = ([("rsp_edge_enhancement", rsp)] if args.rsp else []) + [("feature_nodes", nodes), ("delaunay_image_mesh", delaunay)]
     stages += [] if args.no_smoothing else [("image_mesh_smoothing", mesh)]
@@ -129,7 +135,8 @@ def main():
               "angles_degrees": angles, "smoothing": not args.no_smoothing, "rsp": args.rsp,
               "added_nodes": int(field.get("AddedNodes", 0)) if not args.no_smoothing else 0,
               "object_elements": int(v2n(labelled.GetCellData().GetArray("Label")).sum()),
-              "lambda": float(cut.Lambda), "connectivity": cut.GetProperty("Connectivity").GetData(),
+              "task": cut.GetProperty("Task").GetData(), "lambda": float(cut.Lambda),
+              "connectivity": cut.GetProperty("Connectivity").GetData(),
               "sigma": field.get("Sigma"), "flow": field.get("Flow"),
               "object_components": int(field.get("ObjectComponents", 0)),
               # World units (the image spacing's unit, squared in 2D, cubed in 3D), largest first.

@@ -3,8 +3,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-for c in nuclei-dsb2018 liver-ct-totalseg; do
-  xvfb-run -a pvpython scripts/featuremesh_segment.py "Data/$c/image.mha" \
+# The task as the user would give it: every nucleus like the seeded ones; the one liver.
+for c in nuclei-dsb2018:class liver-ct-totalseg:object; do
+  task=${c#*:}
+  c=${c%:*}
+  xvfb-run -a pvpython scripts/featuremesh_segment.py "Data/$c/image.mha" --task "$task" \
     --object-seeds "Data/$c/seeds_object.csv" --background-seeds "Data/$c/seeds_background.csv" \
     --truth "Data/$c/truth.mha" --out out
 done

@@ -8,6 +8,7 @@ One place for the glue the main script, the benchmarks and the tests share:
     cut = case.super_voxel_cut(case.mesh(case.feature_nodes()))
     print(fm.dice(fm.labels(cut), case.truth()))
 """
+import csv
 import glob
 import os
 
@@ -21,7 +22,7 @@ DATA = os.environ.get("FEATUREMESH_DATA", os.path.join(ROOT, "Data"))
 SHARED = os.environ.get("FEATUREMESH_SHARED_DATA", os.path.join(os.path.dirname(ROOT), "shared", "data"))
 
 __all__ = ["ROOT", "DATA", "SHARED", "np", "v2n", "find_plugin", "load_plugin", "cases", "case_dir", "seeds", "fetch",
-           "labels", "dice", "Case"]
+           "labels", "dice", "case_task", "Case"]
 
 
 def find_plugin():
@@ -61,6 +62,19 @@ def cases(selection=()):
     return {k: v for k, v in found.items() if not selection or k in selection}
 
 
+def case_task(name):
+    """The task a case's seeds ask for ("object" or "class"), from the cases.csv beside it (the shared
+    data's, else Data/cases.csv); None when no list names it."""
+    for root in (os.path.join(SHARED, "cases"), DATA):
+        path = os.path.join(root, "cases.csv")
+        if os.path.isfile(path):
+            with open(path, newline="") as f:
+                for row in csv.DictReader(f):
+                    if row.get("case") == name and row.get("task"):
+                        return row["task"]
+    return None
+
+
 def case_dir(name):
     """The folder of case `name` (bundled first), or None."""
     return cases([name]).get(name)
@@ -90,7 +104,9 @@ def dice(a, b):
 
 class Case:
     """A case folder (image.mha, seeds_object.csv, seeds_background.csv, optional truth.mha) and its
-    pipeline with fresh proxies on every call; properties pass through as keyword arguments."""
+    pipeline with fresh proxies on every call; properties pass through as keyword arguments. Both cuts
+    get the case's task (cases.csv: "object" or "class"; the filters' default when none is listed)
+    unless the keywords set Task."""
 
     def __init__(self, folder, image=None, object_seeds=None, background_seeds=None):
         self.folder = folder
@@ -101,6 +117,12 @@ class Case:
         self.object_seeds = seeds(object_seeds or os.path.join(folder, "seeds_object.csv"))
         self.background_seeds = seeds(background_seeds or os.path.join(folder, "seeds_background.csv"))
         self.is3d = fetch(self.image).GetDimensions()[2] > 1
+        self.task = case_task(self.name)
+
+    def _with_task(self, properties):
+        if self.task and "Task" not in properties:
+            properties = dict(properties, Task=self.task.capitalize())
+        return properties
 
     def truth(self):
         path = os.path.join(self.folder, "truth.mha")
@@ -124,7 +146,7 @@ class Case:
 
     def super_voxel_cut(self, mesh, **properties):
         return ps.SuperVoxelCut(Mesh=mesh, ObjectSeeds=self.object_seeds, BackgroundSeeds=self.background_seeds,
-                                Image=self.image, Scalars=self.scalars, **properties)
+                                Image=self.image, Scalars=self.scalars, **self._with_task(properties))
 
     def surface_smoothing(self, cut, **properties):
         """Segmentation Surface Smoothing of a Super-Voxel Cut proxy (port 0 the smoothed boundary, 1 the labelled mesh)."""
@@ -132,7 +154,7 @@ class Case:
 
     def voxel_cut(self, **properties):
         return ps.VoxelCut(Input=self.image, ObjectSeeds=self.object_seeds, BackgroundSeeds=self.background_seeds,
-                           Scalars=self.scalars, **properties)
+                           Scalars=self.scalars, **self._with_task(properties))
 
     def pipeline(self, **properties):
         """(nodes, mesh, cut) proxies; `properties` maps a filter name to its keyword arguments."""
