@@ -169,6 +169,10 @@ int main(int argc, char* argv[])
   smoothedCut->SetInputData(1, ReadSeeds(caseDir + "seeds_object.csv"));
   smoothedCut->SetInputData(2, ReadSeeds(caseDir + "seeds_background.csv"));
   smoothedCut->SetInputConnection(3, reader->GetOutputPort());
+  // The task a user gives: every nucleus like the seeded ones; the one liver or tumour.
+  const int task = liver || oneCase ? 0 : 1;
+  cut->SetTask(task);
+  smoothedCut->SetTask(task);
   vtkNew<vtkSegmentationSurfaceSmoothing> surface;
   surface->SetInputConnection(smoothedCut->GetOutputPort(0));
 

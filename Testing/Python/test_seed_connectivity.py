@@ -36,8 +36,8 @@ def field(data, name):
 
 for name in ("SuperVoxelCut", "VoxelCut"):
     results = {}
-    for mode in (None, 0, 1, 2):
-        props = {} if mode is None else {"Connectivity": mode}
+    for mode in (None, 0, 1, 2, "class"):
+        props = {} if mode is None else ({"Task": "Class"} if mode == "class" else {"Connectivity": mode})
         if name == "SuperVoxelCut":
             cut = ft.SuperVoxelCut(Mesh=mesh, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, **props)
             out = ft.fetch(cut, 2)
@@ -49,7 +49,8 @@ for name in ("SuperVoxelCut", "VoxelCut"):
     off, fill, seeded = results[0][0], results[1][0], results[2][0]
     # Elements straddle the disks' edges: the super-voxel labels are right up to them.
     good, bad = (0.9, 0.3) if name == "SuperVoxelCut" else (0.99, 0.01)
-    ft.check((results[None][0] == fill).all(), "%s: the default is Fill Holes" % name)
+    ft.check((results[None][0] == seeded).all(), "%s: the default (Task Object, Connectivity From Task) is Seeded Object" % name)
+    ft.check((results["class"][0] == fill).all(), "%s: Task Class (Connectivity From Task) is Fill Holes" % name)
     ft.check(off[left].mean() > good and off[right].mean() > good and off[hole].mean() < bad,
              "%s, off: both disks, the hole background (%.2f %.2f %.2f)" % (name, off[left].mean(), off[right].mean(), off[hole].mean()))
     ft.check(fill[left].mean() > good and fill[right].mean() > good and fill[hole].all(),
