@@ -904,7 +904,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     graph.Step = &pr.Step;
     std::vector<double> spatialObject, spatialBackground;
     if (!SeedGeodesicCosts(graph, pr.Hard, high - low, pr.Geodesic, pr.Parallel, spatialObject, spatialBackground,
-          SubProgress(progress, 0.3, 0.33)))
+          SubProgress(progress, 0.3, 0.33), cache ? &cache->Geodesic : nullptr))
     {
       r.Aborted = true;
       return r;

@@ -143,6 +143,7 @@ public:
   {
     this->State.reset();
     this->Binned.reset();
+    this->Geodesic.Clear();
   }
   bool Empty() const { return !this->State; }
   struct Kept;
@@ -152,6 +153,8 @@ private:
   friend CutResult BoykovJollyCut(const CutProblem&, const BoykovJollyParameters&, const ProgressFunction&, MaxFlowCache*);
   std::shared_ptr<Kept> State;
   std::shared_ptr<BinnedVoxels> Binned;
+  // The seeds' geodesic distances, for a seed edit that adds seeds.
+  SeedGeodesicCache Geodesic;
 };
 
 // Every input is checked first (finite values within +-1e150, non-negative sizes and contacts,

@@ -12,6 +12,7 @@
 #include "Parallel.h"
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -39,17 +40,37 @@ struct GeodesicGraph
 };
 
 // Geodesic distance of every node from the nodes with hard[p] == seedKind (infinity where none is
-// reachable), edge length |dValue| / scale + lengthWeight * step. Dijkstra on a binary heap; for
-// explicit edges a CSR adjacency is built first. Empty when progress asks to abort.
+// reachable), edge length |dValue| / scale + lengthWeight * step. Dijkstra on a binary heap of
+// 8-byte entries (fewer than 2^32 nodes); for explicit edges a CSR adjacency is built first. Empty
+// when progress asks to abort.
 std::vector<double> GeodesicDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
   std::uint8_t seedKind, double scale, double lengthWeight, const ProgressFunction& progress = NoProgress());
 
+// What the spatial term keeps for the next cut of the same graph (values, steps, scale and length
+// weight): the adjacency, and per seed kind the seed nodes and their distances. A cut whose seeds of
+// a kind are the kept ones reuses their distances; one that only adds seeds runs Dijkstra from the
+// new ones, bounded by the kept distances (they only shrink); any other change starts afresh. Not for
+// sharing between threads.
+class SeedGeodesicCache
+{
+public:
+  void Clear() { this->State.reset(); }
+  struct Kept;
+
+private:
+  friend bool SeedGeodesicCosts(const GeodesicGraph&, const std::vector<std::uint8_t>&, double, const SeedGeodesicParameters&,
+    const ParallelFor&, std::vector<double>&, std::vector<double>&, const ProgressFunction&, SeedGeodesicCache*);
+  std::shared_ptr<Kept> State;
+};
+
 // The spatial term per voxel of each node (costObject, costBackground), from the distances to the
-// object and the background seeds, both runs split over `parallel` (two at most). False when
-// progress asks to abort; true with empty costs when Weight is 0 or either seed kind is absent.
+// object and the background seeds; the two runs share `parallel`'s threads (two at most; progress
+// is then reported between them only). False when progress asks to abort; true with empty costs
+// when Weight is 0 or either seed kind is absent. `cache` (optional) keeps what the next cut reuses.
 bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard, double scale,
   const SeedGeodesicParameters& parameters, const ParallelFor& parallel, std::vector<double>& costObject,
-  std::vector<double>& costBackground, const ProgressFunction& progress = NoProgress());
+  std::vector<double>& costBackground, const ProgressFunction& progress = NoProgress(),
+  SeedGeodesicCache* cache = nullptr);
 
 // Empty when usable, else a sentence.
 std::string ValidateParameters(const SeedGeodesicParameters& p);

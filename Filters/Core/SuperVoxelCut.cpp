@@ -144,6 +144,7 @@ bool PrepareVoxelOwners(const SimplexMesh& mesh, SuperVoxelCutData& data, const 
   {
     data.Owner.Own(VoxelOwners(ElementRasterizer(mesh), parallel, progress));
   }
+  data.CentreSteps = CentreDistances(mesh, mesh.Faces());
   return !data.Owner.empty();
 }
 
@@ -228,7 +229,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   if (parameters.Task == Task::Object)
   {
     pr.Geodesic = parameters.Geodesic;
-    pr.Step = CentreDistances(mesh, adj);
+    pr.Step = data.CentreSteps.size() == adj.A.size() ? data.CentreSteps : CentreDistances(mesh, adj);
   }
   result.SetupSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
   result.Cut = BoykovJollyCut(pr, parameters, progress, flow);

@@ -83,6 +83,8 @@ struct SuperVoxelCutData
   VoxelOwnerMap Owner;
   // The voxel values with their elements (viewed); empty without voxel values.
   NodeVoxelValues Voxels;
+  // CentreDistances of the mesh, for the geodesic spatial term (made by PrepareVoxelOwners).
+  std::vector<double> CentreSteps;
   bool HasVoxelValues() const { return !this->Voxels.Empty(); }
 };
 

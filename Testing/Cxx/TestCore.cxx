@@ -1849,6 +1849,64 @@ TEST(Task, TheGeodesicTermFindsWhatTheHistogramsCannot)
   }
 }
 
+TEST(SeedGeodesics, KeptDistancesEqualFreshOnes)
+{
+  // A noisy 40 x 30 grid as explicit edges with random steps; a chain of seed edits through one
+  // cache: seeds added, removed, moved, both kinds at once, nothing changed. Every cut's costs
+  // equal those computed afresh (up to the rounding of equal-length paths summed in another order).
+  ImageGeometry g = Grid2(40, 30);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<double> value(g.Size());
+  for (int j = 0; j < 30; ++j)
+    for (int i = 0; i < 40; ++i)
+      value[g.Index(i, j, 0)] = (std::hypot(i - 15, j - 15) < 9 ? 50.0 : 10.0) + 5.0 * u(rng);
+  std::vector<std::int64_t> a, b;
+  std::vector<double> step;
+  GraphEdges::Grid(40, 30, 1).ForEach([&](std::int64_t, std::int64_t p, std::int64_t q) {
+    a.push_back(p);
+    b.push_back(q);
+    step.push_back(0.5 + u(rng));
+  });
+  const GraphEdges edges(a, b);
+  GeodesicGraph graph;
+  graph.Edges = &edges;
+  graph.Value = value.data();
+  graph.Nodes = g.Size();
+  graph.Step = &step;
+  const std::vector<std::vector<std::int64_t>> object = { { g.Index(15, 15, 0) }, { g.Index(15, 15, 0), g.Index(12, 18, 0) },
+    { g.Index(12, 18, 0) }, { g.Index(13, 18, 0) }, { g.Index(13, 18, 0), g.Index(18, 12, 0) }, { g.Index(13, 18, 0), g.Index(18, 12, 0) },
+    { g.Index(16, 16, 0) } };
+  const std::vector<std::vector<std::int64_t>> background = { { g.Index(1, 1, 0) }, { g.Index(1, 1, 0) },
+    { g.Index(1, 1, 0), g.Index(38, 28, 0) }, { g.Index(38, 28, 0) }, { g.Index(2, 1, 0), g.Index(30, 5, 0) },
+    { g.Index(2, 1, 0), g.Index(30, 5, 0) }, { g.Index(39, 29, 0), g.Index(0, 29, 0) } };
+  SeedGeodesicCache cache;
+  SeedGeodesicParameters p;
+  for (std::size_t edit = 0; edit < object.size(); ++edit)
+  {
+    std::vector<std::uint8_t> hard(g.Size(), 0);
+    for (std::int64_t v : object[edit])
+      hard[v] = 1;
+    for (std::int64_t v : background[edit])
+      hard[v] = 2;
+    std::vector<double> keptObject, keptBackground, freshObject, freshBackground;
+    ASSERT_TRUE(SeedGeodesicCosts(graph, hard, 40.0, p, SerialFor(), keptObject, keptBackground, NoProgress(), &cache));
+    ASSERT_TRUE(SeedGeodesicCosts(graph, hard, 40.0, p, SerialFor(), freshObject, freshBackground));
+    ASSERT_EQ(keptObject.size(), freshObject.size());
+    for (std::size_t v = 0; v < freshObject.size(); ++v)
+    {
+      ASSERT_NEAR(keptObject[v], freshObject[v], 1e-9) << "edit " << edit << " node " << v;
+      ASSERT_NEAR(keptBackground[v], freshBackground[v], 1e-9) << "edit " << edit << " node " << v;
+    }
+    for (int kind : { 1, 2 })
+    {
+      const std::vector<double> d = GeodesicDistances(graph, hard, static_cast<std::uint8_t>(kind), 40.0, p.LengthWeight);
+      for (std::int64_t v : kind == 1 ? object[edit] : background[edit])
+        EXPECT_EQ(d[v], 0.0);
+    }
+  }
+}
+
 TEST(SeedGeodesics, DistancesAddTheStepsAndTheLength)
 {
   // A chain 0 - 1 - 2 - 3 of values 0, 0, 10, 10 (range 10): each step costs |dI| / 10 plus the
