@@ -70,10 +70,10 @@ class Loop:
                 mesh = case.smoothing(case.mesh(case.feature_nodes()))
                 mesh.UpdatePipeline()
                 self.proxy = ps.SuperVoxelCut(Mesh=mesh, ObjectSeeds=self.object, BackgroundSeeds=self.background,
-                                              Image=case.image, Scalars=case.scalars, **case._with_task({}))
+                                              Image=case.image, Scalars=case.scalars, **case.with_task({}))
             else:
                 self.proxy = ps.VoxelCut(Input=case.image, ObjectSeeds=self.object, BackgroundSeeds=self.background,
-                                         Scalars=case.scalars, **case._with_task({}))
+                                         Scalars=case.scalars, **case.with_task({}))
         else:
             self.unit = metrics.unit_range(fm.v2n(image.GetPointData().GetScalars()).reshape(self.shape))
 

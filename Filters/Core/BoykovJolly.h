@@ -153,7 +153,7 @@ private:
   friend CutResult BoykovJollyCut(const CutProblem&, const BoykovJollyParameters&, const ProgressFunction&, MaxFlowCache*);
   std::shared_ptr<Kept> State;
   std::shared_ptr<BinnedVoxels> Binned;
-  // The seeds' geodesic distances, for a seed edit that adds seeds.
+  // The seeds' geodesic distances, updated rather than redone after a seed edit.
   SeedGeodesicCache Geodesic;
 };
 

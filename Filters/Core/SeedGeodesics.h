@@ -21,8 +21,8 @@ namespace featuremesh
 struct SeedGeodesicParameters
 {
   // Weight of the spatial term against the appearance term (both per voxel, in nats); 0 = off.
-  // 1.5 and 0.005: the best of a 3 x 2 grid on the three shared object cases, the one that keeps
-  // the Delaunay and the smoothed mesh's Dice closest (README, "The task and the seeds' spatial term").
+  // 1.5 and 0.005: of the weights and lengths tried on the three shared object cases, the pair that
+  // keeps the Delaunay and the smoothed mesh's Dice closest (README, "The seeds' spatial term").
   double Weight = 1.5;
   // Length of one voxel of travel, in units of the intensity range: a path through a homogeneous
   // region costs about this per voxel, so seeds reach far across flat regions and stop at edges.
@@ -47,10 +47,11 @@ std::vector<double> GeodesicDistances(const GeodesicGraph& graph, const std::vec
   std::uint8_t seedKind, double scale, double lengthWeight, const ProgressFunction& progress = NoProgress());
 
 // What the spatial term keeps for the next cut of the same graph (values, steps, scale and length
-// weight): the adjacency, and per seed kind the seed nodes and their distances. A cut whose seeds of
-// a kind are the kept ones reuses their distances; one that only adds seeds runs Dijkstra from the
-// new ones, bounded by the kept distances (they only shrink); any other change starts afresh. Not for
-// sharing between threads.
+// weight): the adjacency, and per seed kind the seed nodes, their distances and each node's root
+// seed. A cut whose seeds of a kind are the kept ones reuses their distances; added seeds run
+// Dijkstra from themselves, bounded by the kept distances (they only shrink); nodes rooted at a
+// removed seed restart from their neighbours that kept theirs. Any other change starts afresh. Not
+// for sharing between threads.
 class SeedGeodesicCache
 {
 public:

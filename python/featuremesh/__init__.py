@@ -119,7 +119,8 @@ class Case:
         self.is3d = fetch(self.image).GetDimensions()[2] > 1
         self.task = case_task(self.name)
 
-    def _with_task(self, properties):
+    def with_task(self, properties):
+        """`properties` with Task set to the case's task, unless they set it."""
         if self.task and "Task" not in properties:
             properties = dict(properties, Task=self.task.capitalize())
         return properties
@@ -146,7 +147,7 @@ class Case:
 
     def super_voxel_cut(self, mesh, **properties):
         return ps.SuperVoxelCut(Mesh=mesh, ObjectSeeds=self.object_seeds, BackgroundSeeds=self.background_seeds,
-                                Image=self.image, Scalars=self.scalars, **self._with_task(properties))
+                                Image=self.image, Scalars=self.scalars, **self.with_task(properties))
 
     def surface_smoothing(self, cut, **properties):
         """Segmentation Surface Smoothing of a Super-Voxel Cut proxy (port 0 the smoothed boundary, 1 the labelled mesh)."""
@@ -154,7 +155,7 @@ class Case:
 
     def voxel_cut(self, **properties):
         return ps.VoxelCut(Input=self.image, ObjectSeeds=self.object_seeds, BackgroundSeeds=self.background_seeds,
-                           Scalars=self.scalars, **self._with_task(properties))
+                           Scalars=self.scalars, **self.with_task(properties))
 
     def pipeline(self, **properties):
         """(nodes, mesh, cut) proxies; `properties` maps a filter name to its keyword arguments."""
