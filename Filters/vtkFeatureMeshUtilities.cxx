@@ -2,6 +2,10 @@
 #include "Memory.h"
 
 #include "Contract.h"
+#include "MultiLabelCut.h"
+#include "vtkTable.h"
+#include "vtkStringArray.h"
+#include "vtkAbstractArray.h"
 
 #include "vtkAlgorithm.h"
 #include "vtkCellArray.h"
@@ -261,6 +265,92 @@ bool ObjectAndBackgroundVoxels(vtkPointSet* object, vtkPointSet* background, con
 {
   return SeedVoxels(PointsOf(object), geometry, "object", objectVoxels, error) &&
     SeedVoxels(PointsOf(background), geometry, "background", backgroundVoxels, error);
+}
+
+namespace
+{
+bool SameName(const char* a, const char* b)
+{
+  if (!a || !b)
+  {
+    return false;
+  }
+  for (; *a && *b; ++a, ++b)
+  {
+    if (std::tolower(static_cast<unsigned char>(*a)) != std::tolower(static_cast<unsigned char>(*b)))
+    {
+      return false;
+    }
+  }
+  return *a == *b;
+}
+
+vtkDataArray* NumericColumn(vtkFieldData* data, const char* name)
+{
+  for (int i = 0; data && i < data->GetNumberOfArrays(); ++i)
+  {
+    vtkAbstractArray* a = data->GetAbstractArray(i);
+    if (a && SameName(a->GetName(), name))
+    {
+      return vtkDataArray::SafeDownCast(a);
+    }
+  }
+  return nullptr;
+}
+} // namespace
+
+bool LabelledSeedVoxels(vtkDataObject* seeds, const char* labelArray, const ImageGeometry& geometry,
+  LabelledSeeds& out, std::string& error)
+{
+  out = LabelledSeeds();
+  const std::string name = labelArray && *labelArray ? labelArray : names::Label;
+  std::vector<std::array<double, 3>> world;
+  vtkDataArray* label = nullptr;
+  if (auto* points = vtkPointSet::SafeDownCast(seeds))
+  {
+    world = PointsOf(points);
+    label = NumericColumn(points->GetPointData(), name.c_str());
+  }
+  else if (auto* table = vtkTable::SafeDownCast(seeds))
+  {
+    vtkDataArray* xyz[3] = { NumericColumn(table->GetRowData(), "x"), NumericColumn(table->GetRowData(), "y"),
+      NumericColumn(table->GetRowData(), "z") };
+    if (!xyz[0] || !xyz[1])
+    {
+      error = "the seed table needs numeric columns x, y (and z in 3D).";
+      return false;
+    }
+    for (vtkIdType r = 0; r < table->GetNumberOfRows(); ++r)
+    {
+      world.push_back({ { xyz[0]->GetComponent(r, 0), xyz[1]->GetComponent(r, 0), xyz[2] ? xyz[2]->GetComponent(r, 0) : 0.0 } });
+    }
+    label = NumericColumn(table->GetRowData(), name.c_str());
+  }
+  else
+  {
+    error = "the seeds must be a point set or a table.";
+    return false;
+  }
+  if (!label || label->GetNumberOfComponents() != 1)
+  {
+    error = "the seeds have no one-component numeric array named " + name + " (0 background, 1..k objects).";
+    return false;
+  }
+  std::vector<double> labels(label->GetNumberOfTuples());
+  for (vtkIdType i = 0; i < label->GetNumberOfTuples(); ++i)
+  {
+    labels[i] = label->GetComponent(i, 0);
+  }
+  error = ValidateSeedLabels(labels);
+  if (!error.empty() || !SeedVoxels(world, geometry, "labelled", out.Voxel, error))
+  {
+    return false;
+  }
+  for (double l : labels)
+  {
+    out.Label.push_back(static_cast<std::uint8_t>(l));
+  }
+  return true;
 }
 
 bool ToSimplexMesh(vtkUnstructuredGrid* grid, const ImageGeometry& geometry, SimplexMesh& mesh, std::string& error)
@@ -779,4 +869,28 @@ void AddObjectComponents(vtkDataObject* object, const std::vector<double>& compo
   AddFieldValue(object, names::ConnectivityChanged, static_cast<double>(connectivityChanged));
 }
 
+} // namespace featuremesh
+
+namespace featuremesh
+{
+void AddLabelTable(vtkDataObject* object, int labels, const std::string& text)
+{
+  AddFieldValue(object, names::Labels, labels);
+  vtkNew<vtkStringArray> list;
+  list->SetName(names::LabelNames);
+  list->SetNumberOfValues(labels);
+  std::size_t from = 0;
+  for (int l = 0; l < labels; ++l)
+  {
+    std::string name;
+    if (from <= text.size())
+    {
+      const std::size_t end = std::min(text.find(';', from), text.size());
+      name = text.substr(from, end - from);
+      from = end + 1;
+    }
+    list->SetValue(l, name);
+  }
+  object->GetFieldData()->AddArray(list);
+}
 } // namespace featuremesh

@@ -34,6 +34,8 @@ class vtkUnstructuredGrid;
 
 namespace featuremesh
 {
+struct LabelledSeeds;
+
 // Reports an exception that escaped a filter's body as its error (out of memory, or a library's
 // failure); returns 0.
 int ReportException(vtkAlgorithm* algorithm, const char* filter, const std::exception_ptr& error);
@@ -125,6 +127,12 @@ std::vector<std::array<double, 3>> PointsOf(vtkPointSet* points);
 bool ObjectAndBackgroundVoxels(vtkPointSet* object, vtkPointSet* background, const ImageGeometry& geometry,
   std::vector<std::int64_t>& objectVoxels, std::vector<std::int64_t>& backgroundVoxels, std::string& error);
 
+// Labelled seeds from a point set (a point array named `labelArray`) or a table (columns x, y, z and
+// `labelArray`, as a CSV reader gives them), names matched without case: their voxels and labels
+// (0 background, 1..k objects, checked by ValidateSeedLabels). False with a sentence.
+bool LabelledSeedVoxels(vtkDataObject* seeds, const char* labelArray, const ImageGeometry& geometry,
+  LabelledSeeds& out, std::string& error);
+
 // A triangle (2D) / tetrahedral (3D) unstructured grid as a SimplexMesh on `geometry`'s index
 // space, every element positively oriented there; false with a sentence for mixed or other cell
 // types, or a cell type that does not match the image's dimension.
@@ -204,6 +212,10 @@ void BoundaryPolyData(vtkPoints* points, const std::vector<std::int64_t>& faces,
 
 // Adds a one-value double array `name` to the object's field data (summaries, timings).
 void AddFieldValue(vtkDataObject* object, const char* name, double value);
+
+// Field data Labels (the count) and LabelNames (one string per label, from `names` split at ';',
+// empty where it gives none).
+void AddLabelTable(vtkDataObject* object, int labels, const std::string& names);
 
 // Adds the object components of a cut to the field data: ObjectComponents (their number),
 // ObjectComponentVolumes (world units, largest first) and ConnectivityChanged.

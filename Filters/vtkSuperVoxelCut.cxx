@@ -1,6 +1,7 @@
 #include "vtkSuperVoxelCut.h"
 
 #include "Contract.h"
+#include "MultiLabelCut.h"
 #include "SuperVoxelCut.h"
 #include "vtkFeatureMeshUtilities.h"
 
@@ -18,6 +19,8 @@
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkPolyData.h"
+#include "vtkStringArray.h"
+#include "vtkTable.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
@@ -38,6 +41,12 @@ struct vtkSuperVoxelCut::MeshData
   std::vector<double> Mean, Count;
   featuremesh::SuperVoxelCutData Cut;
   featuremesh::MaxFlowCache Flow;
+  // For labelled seeds, made when first asked for: the voxels' channel bins, each element's runs of
+  // them and its channel means, and what the last multi-label cut keeps.
+  featuremesh::ChannelBins Bins;
+  featuremesh::NodeBinRuns Runs;
+  std::vector<double> ChannelMean, ChannelCount;
+  featuremesh::MultiLabelCache Multi;
 
   MeshData(std::initializer_list<vtkObject*> sources, const featuremesh::ImageGeometry& frame)
     : Frame(frame)
@@ -70,16 +79,18 @@ vtkSuperVoxelCut::vtkSuperVoxelCut()
   this->VoxelRegionTerm = defaults.VoxelRegionTerm;
   this->SampleSeedElements = defaults.SampleSeedElements;
   this->SeedRadius = defaults.SeedRadius;
-  this->SetNumberOfInputPorts(4);
+  this->SeedLabelArray = featuremesh::names::Label;
+  this->ChannelModel = static_cast<int>(featuremesh::MultiLabelParameters().Channels);
+  this->SetNumberOfInputPorts(5);
   this->SetNumberOfOutputPorts(3);
   this->SetInputArrayToProcess(0, 3, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
 }
 
 int vtkSuperVoxelCut::FillInputPortInformation(int port, vtkInformation* info)
 {
-  const char* types[4] = { "vtkUnstructuredGrid", "vtkPointSet", "vtkPointSet", "vtkImageData" };
+  const char* types[5] = { "vtkUnstructuredGrid", "vtkPointSet", "vtkPointSet", "vtkImageData", "vtkDataObject" };
   info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), types[port]);
-  if (port == 3)
+  if (port > 0)
   {
     info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
   }
@@ -132,6 +143,7 @@ int vtkSuperVoxelCut::RequestData(
     vtkPointSet* objectSeeds = vtkPointSet::GetData(inputVector[1], 0);
     vtkPointSet* backgroundSeeds = vtkPointSet::GetData(inputVector[2], 0);
     vtkImageData* image = vtkImageData::GetData(inputVector[3], 0);
+    vtkDataObject* labelledSeeds = vtkDataObject::GetData(inputVector[4], 0);
     vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
     vtkPolyData* boundary = vtkPolyData::GetData(outputVector, 1);
     vtkImageData* labelImage = vtkImageData::GetData(outputVector, 2);
@@ -196,6 +208,17 @@ int vtkSuperVoxelCut::RequestData(
         return fail(error);
       }
     }
+    if (!labelledSeeds && (!objectSeeds || !backgroundSeeds))
+    {
+      return fail("connect the Object Seeds and the Background Seeds, or labelled Seeds.");
+    }
+    // A multi-channel image serves labelled seeds only; the binary preparation below leaves it out.
+    vtkDataArray* binaryValues = valuesArray && valuesArray->GetNumberOfComponents() == 1 ? valuesArray : nullptr;
+    if (valuesArray && !binaryValues && !labelledSeeds)
+    {
+      return fail("the image array has " + std::to_string(valuesArray->GetNumberOfComponents()) +
+        " components; a binary cut takes one (choose a one-component array), labelled Seeds take several.");
+    }
     // The mesh-dependent data: kept from the last run when the mesh, the image and its array are
     // the same objects, unmodified (a seed edit).
     MeshData key({ input->GetPoints(), input->GetCells(), meanArray, countArray, valuesArray }, geometry);
@@ -225,7 +248,7 @@ int vtkSuperVoxelCut::RequestData(
           (badMean ? " NaN or infinite values" : " negative or non-finite values") + "; recompute the mesh with Delaunay Image Mesh.");
       }
       // The image is read in its own type (checked as ToDouble would, without the copy).
-      if (valuesArray && !CheckDouble(valuesArray, error))
+      if (binaryValues && !CheckDouble(binaryValues, error))
       {
         return fail(error);
       }
@@ -239,17 +262,17 @@ int vtkSuperVoxelCut::RequestData(
       }
       const ProgressFunction progress = AlgorithmProgress(this, 0.1, 0.4);
       bool ready = false;
-      if (!valuesArray)
+      if (!binaryValues)
       {
         ready = PrepareSuperVoxelCut(prepared->Mesh, static_cast<const double*>(nullptr), prepared->Cut, error, SMPParallelFor(), progress);
       }
       else
       {
-        switch (valuesArray->GetDataType())
+        switch (binaryValues->GetDataType())
         {
-          vtkTemplateMacro(ready = PrepareSuperVoxelCut(prepared->Mesh, static_cast<const VTK_TT*>(valuesArray->GetVoidPointer(0)),
+          vtkTemplateMacro(ready = PrepareSuperVoxelCut(prepared->Mesh, static_cast<const VTK_TT*>(binaryValues->GetVoidPointer(0)),
                              prepared->Cut, error, SMPParallelFor(), progress,
-                             std::make_shared<vtkSmartPointer<vtkDataArray>>(valuesArray)));
+                             std::make_shared<vtkSmartPointer<vtkDataArray>>(binaryValues)));
           default:
             error = "the array's value type is not supported.";
         }
@@ -263,7 +286,25 @@ int vtkSuperVoxelCut::RequestData(
     MeshData& data = *this->Prepared;
     const SimplexMesh& mesh = data.Mesh;
     std::vector<std::int64_t> objectVoxels, backgroundVoxels;
-    if (!ObjectAndBackgroundVoxels(objectSeeds, backgroundSeeds, geometry, objectVoxels, backgroundVoxels, error))
+    if (labelledSeeds)
+    {
+      LabelledSeeds seeds;
+      if (!LabelledSeedVoxels(labelledSeeds, this->SeedLabelArray.c_str(), geometry, seeds, error))
+      {
+        return fail(error);
+      }
+      if (!(std::count(seeds.Label.begin(), seeds.Label.end(), 0) + std::count(seeds.Label.begin(), seeds.Label.end(), 1) ==
+              static_cast<std::ptrdiff_t>(seeds.Label.size()) && binaryValues == valuesArray))
+      {
+        return this->RequestMultiLabel(input, seeds, valuesArray, par, outputVector);
+      }
+      // One object on one channel: alpha-expansion with two labels is the binary cut.
+      for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
+      {
+        (seeds.Label[s] ? objectVoxels : backgroundVoxels).push_back(seeds.Voxel[s]);
+      }
+    }
+    else if (!ObjectAndBackgroundVoxels(objectSeeds, backgroundSeeds, geometry, objectVoxels, backgroundVoxels, error))
     {
       return fail(error);
     }
@@ -271,9 +312,9 @@ int vtkSuperVoxelCut::RequestData(
     this->UpdateProgress(0.45);
     const ParallelFor parallel = SMPParallelFor();
     VoxelValueFunction voxelValue;
-    if (valuesArray)
+    if (binaryValues)
     {
-      voxelValue = [valuesArray](std::int64_t v) { return valuesArray->GetComponent(v, 0); };
+      voxelValue = [binaryValues](std::int64_t v) { return binaryValues->GetComponent(v, 0); };
     }
     const SuperVoxelCutResult result = featuremesh::SuperVoxelCut(mesh, data.Cut, data.Mean, data.Count, objectVoxels,
       backgroundVoxels, voxelValue, par, parallel, AlgorithmProgress(this, 0.45, 0.95), &data.Flow);
@@ -336,6 +377,103 @@ int vtkSuperVoxelCut::RequestData(
   });
 }
 
+int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featuremesh::LabelledSeeds& seeds,
+  vtkDataArray* values, const featuremesh::SuperVoxelCutParameters& par, vtkInformationVector* outputVector)
+{
+  using namespace featuremesh;
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  if (!values)
+  {
+    vtkErrorMacro("Super-Voxel Cut: labelled seeds with more than one object need the Image input.");
+    return 0;
+  }
+  MeshData& data = *this->Prepared;
+  const SimplexMesh& mesh = data.Mesh;
+  const ImageGeometry& geometry = mesh.Geometry();
+  const ParallelFor parallel = SMPParallelFor();
+  const int channels = values->GetNumberOfComponents();
+  std::string error;
+  if (data.Bins.Channels != channels || data.Bins.PerChannel != BinsPerChannel(channels, par.Bins))
+  {
+    data.Bins = ChannelBins();
+    bool binned = false;
+    switch (values->GetDataType())
+    {
+      vtkTemplateMacro(const VTK_TT* v = static_cast<const VTK_TT*>(values->GetVoidPointer(0));
+                       binned = BinChannels(v, channels, geometry.Size(), par.Bins, data.Bins, error, parallel);
+                       if (binned) {
+                         NodeChannelMeans(data.Cut.Owner.data(), v, channels, geometry.Size(), mesh.NumberOfElements(),
+                           data.ChannelMean, data.ChannelCount);
+                       });
+      default:
+        error = "the array's value type is not supported.";
+    }
+    if (!binned)
+    {
+      data.Bins = ChannelBins();
+      vtkErrorMacro("Super-Voxel Cut: " << error);
+      return 0;
+    }
+    data.Runs = GroupNodeBins(data.Cut.Owner.data(), data.Bins, mesh.NumberOfElements());
+    data.Multi.Clear();
+  }
+  this->UpdateProgress(0.45);
+  MultiLabelParameters multi;
+  multi.Channels = static_cast<featuremesh::ChannelModel>(this->ChannelModel);
+  const MultiLabelResult result = MultiLabelSuperVoxelCut(mesh, data.Cut, data.Bins, data.Runs, data.ChannelMean,
+    data.ChannelCount, seeds, par, multi, parallel, AlgorithmProgress(this, 0.45, 0.95), &data.Multi);
+  if (result.Aborted)
+  {
+    return 1;
+  }
+  if (!result.Error.empty())
+  {
+    vtkErrorMacro("Super-Voxel Cut: " << result.Error);
+    return 0;
+  }
+  vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
+  vtkPolyData* boundary = vtkPolyData::GetData(outputVector, 1);
+  vtkImageData* labelImage = vtkImageData::GetData(outputVector, 2);
+  output->ShallowCopy(input);
+  DropVoxelOwners(output);
+  vtkNew<vtkUnsignedCharArray> label;
+  label->SetName(names::Label);
+  label->SetNumberOfTuples(mesh.NumberOfElements());
+  std::copy(result.Label.begin(), result.Label.end(), label->GetPointer(0));
+  output->GetCellData()->AddArray(label);
+  output->GetCellData()->SetActiveScalars(names::Label);
+  BoundaryPolyData(input->GetPoints(), result.BoundaryFaces, mesh.VerticesPerCell() - 1, boundary);
+  SetImageFrame(labelImage, geometry);
+  vtkNew<vtkUnsignedCharArray> voxels;
+  voxels->SetName(names::Label);
+  voxels->SetNumberOfTuples(geometry.Size());
+  VoxelLabels(data.Cut.Owner, result.Label, voxels->GetPointer(0), parallel);
+  labelImage->GetPointData()->SetScalars(voxels);
+  if (this->SuperVoxelIds)
+  {
+    vtkNew<vtkIdTypeArray> ids;
+    ids->SetName(names::ElementId);
+    ids->SetNumberOfTuples(geometry.Size());
+    std::copy(data.Cut.Owner.begin(), data.Cut.Owner.end(), ids->GetPointer(0));
+    labelImage->GetPointData()->AddArray(ids);
+  }
+  for (vtkDataObject* d : { static_cast<vtkDataObject*>(output), static_cast<vtkDataObject*>(labelImage) })
+  {
+    AddLabelTable(d, result.Labels, this->LabelNames);
+    AddFieldValue(d, names::Sigma, result.Sigma);
+    AddFieldValue(d, names::Energy, result.Energy);
+    AddFieldValue(d, names::ExpansionMoves, result.Moves);
+    AddFieldValue(d, names::ExpansionCycles, result.Cycles);
+    AddFieldValue(d, names::SetupSeconds, result.SetupSeconds);
+    AddFieldValue(d, names::ExpansionSeconds, result.ExpansionSeconds);
+    AddFieldValue(d, names::GeodesicSeconds, result.GeodesicSeconds);
+    AddFieldValue(d, names::CutTotalSeconds, std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
 void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
@@ -349,5 +487,8 @@ void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
      << indent << "Bandwidth: " << this->Bandwidth << "\n"
      << indent << "SuperVoxelIds: " << this->SuperVoxelIds << "\n"
      << indent << "ScaleByContact: " << this->ScaleByContact << "\n"
-     << indent << "VoxelRegionTerm: " << this->VoxelRegionTerm << "\n";
+     << indent << "VoxelRegionTerm: " << this->VoxelRegionTerm << "\n"
+     << indent << "SeedLabelArray: " << this->SeedLabelArray << "\n"
+     << indent << "ChannelModel: " << this->ChannelModel << "\n"
+     << indent << "LabelNames: " << this->LabelNames << "\n";
 }

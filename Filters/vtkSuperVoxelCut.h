@@ -8,7 +8,8 @@
  * voxel units. That scaling is the default because it makes the element energy a discretisation of
  * the same energy as the voxel cut (each voxel face counts 1), so lambda and sigma mean the same in
  * both. Inputs: 0 "Mesh", 1 "Object Seeds", 2 "Background Seeds", optional 3 "Image" (then the
- * seed histograms use the voxels of the seed elements rather than their means). A seed belongs to
+ * seed histograms use the voxels of the seed elements rather than their means), optional 4 "Seeds"
+ * (labelled seeds instead of ports 1 and 2: k objects by alpha-expansion, featuremesh::MultiLabelCut). A seed belongs to
  * the element that owns the voxel containing it. Outputs: 0 the mesh with cell array `Label`
  * (1 object, 0 background); 1 the boundary between labels (2D polylines, 3D a closed outward
  * triangle surface on the mesh's points); 2 the labels rasterised on the image grid (uint8).
@@ -20,6 +21,15 @@
 #include "vtkUnstructuredGridAlgorithm.h"
 
 #include <memory>
+#include <string>
+
+class vtkDataArray;
+class vtkUnstructuredGrid;
+namespace featuremesh
+{
+struct LabelledSeeds;
+struct SuperVoxelCutParameters;
+}
 
 class FEATUREMESHFILTERS_EXPORT vtkSuperVoxelCut : public vtkUnstructuredGridAlgorithm
 {
@@ -76,6 +86,17 @@ public:
   /// Radius (voxels) of each seed's neighbourhood when SampleSeedElements is off.
   vtkSetMacro(SeedRadius, double);
   vtkGetMacro(SeedRadius, double);
+  /// With the Seeds input (port 4): the name of its label array or column (default Label, matched
+  /// without case; 0 background, 1..k objects).
+  vtkSetStdStringFromCharMacro(SeedLabelArray);
+  vtkGetCharFromStdStringMacro(SeedLabelArray);
+  /// With labelled seeds on a multi-channel image (featuremesh::ChannelModel): 0 one joint density
+  /// over the channels (default), 1 the product of one density per channel.
+  vtkSetClampMacro(ChannelModel, int, 0, 1);
+  vtkGetMacro(ChannelModel, int);
+  /// Names of labels 0..k, separated by ';' (optional): the outputs' LabelNames field data.
+  vtkSetStdStringFromCharMacro(LabelNames);
+  vtkGetCharFromStdStringMacro(LabelNames);
 
 protected:
   vtkSuperVoxelCut();
@@ -100,8 +121,14 @@ protected:
   bool SampleSeedElements;
   bool SuperVoxelIds = false;
   double SeedRadius;
+  std::string SeedLabelArray;
+  int ChannelModel;
+  std::string LabelNames;
 
 private:
+  // The cut with labelled seeds on the Seeds input.
+  int RequestMultiLabel(vtkUnstructuredGrid* input, const featuremesh::LabelledSeeds& seeds, vtkDataArray* values,
+    const featuremesh::SuperVoxelCutParameters& parameters, vtkInformationVector* outputVector);
   // What depends on the mesh and the image alone (the simplex mesh with its adjacency, the voxel
   // owners, the element statistics and voxel values), kept while they do not change: a seed edit
   // re-runs only the cut.

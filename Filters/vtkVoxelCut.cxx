@@ -1,6 +1,7 @@
 #include "vtkVoxelCut.h"
 
 #include "Contract.h"
+#include "MultiLabelCut.h"
 #include "SuperVoxelCut.h"
 #include "vtkFeatureMeshUtilities.h"
 
@@ -34,13 +35,19 @@ vtkVoxelCut::vtkVoxelCut()
   this->GeodesicLength = defaults.Geodesic.LengthWeight;
   this->Bandwidth = defaults.Bandwidth;
   this->SeedRadius = defaults.SeedRadius;
-  this->SetNumberOfInputPorts(3);
+  this->SeedLabelArray = featuremesh::names::Label;
+  this->ChannelModel = static_cast<int>(featuremesh::MultiLabelParameters().Channels);
+  this->SetNumberOfInputPorts(4);
   this->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
 }
 
 int vtkVoxelCut::FillInputPortInformation(int port, vtkInformation* info)
 {
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port == 0 ? "vtkImageData" : "vtkPointSet");
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port == 0 ? "vtkImageData" : (port == 3 ? "vtkDataObject" : "vtkPointSet"));
+  if (port > 0)
+  {
+    info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  }
   return 1;
 }
 
@@ -70,6 +77,7 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     vtkImageData* image = vtkImageData::GetData(inputVector[0], 0);
     vtkPointSet* objectSeeds = vtkPointSet::GetData(inputVector[1], 0);
     vtkPointSet* backgroundSeeds = vtkPointSet::GetData(inputVector[2], 0);
+    vtkDataObject* labelledSeeds = vtkDataObject::GetData(inputVector[3], 0);
     vtkImageData* output = vtkImageData::GetData(outputVector, 0);
     std::string error, warning;
     auto fail = [&](const std::string& why) {
@@ -101,7 +109,33 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
       return fail(error);
     }
     std::vector<std::int64_t> objectVoxels, backgroundVoxels;
-    if (!ObjectAndBackgroundVoxels(objectSeeds, backgroundSeeds, geometry, objectVoxels, backgroundVoxels, error))
+    if (labelledSeeds)
+    {
+      LabelledSeeds seeds;
+      if (!LabelledSeedVoxels(labelledSeeds, this->SeedLabelArray.c_str(), geometry, seeds, error))
+      {
+        return fail(error);
+      }
+      vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
+      if (!array)
+      {
+        return fail(error);
+      }
+      if (*std::max_element(seeds.Label.begin(), seeds.Label.end()) > 1 || array->GetNumberOfComponents() > 1)
+      {
+        return this->RequestMultiLabel(seeds, array, geometry, par, outputVector);
+      }
+      // One object on one channel: alpha-expansion with two labels is the binary cut.
+      for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
+      {
+        (seeds.Label[s] ? objectVoxels : backgroundVoxels).push_back(seeds.Voxel[s]);
+      }
+    }
+    else if (!objectSeeds || !backgroundSeeds)
+    {
+      return fail("connect the Object Seeds and the Background Seeds, or labelled Seeds.");
+    }
+    else if (!ObjectAndBackgroundVoxels(objectSeeds, backgroundSeeds, geometry, objectVoxels, backgroundVoxels, error))
     {
       return fail(error);
     }
@@ -145,6 +179,63 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
   });
 }
 
+int vtkVoxelCut::RequestMultiLabel(const featuremesh::LabelledSeeds& seeds, vtkDataArray* array,
+  const featuremesh::ImageGeometry& geometry, const featuremesh::VoxelCutParameters& par, vtkInformationVector* outputVector)
+{
+  using namespace featuremesh;
+  const auto start = std::chrono::steady_clock::now();
+  const int channels = array->GetNumberOfComponents();
+  const std::int64_t n = geometry.Size();
+  ChannelBins bins;
+  std::vector<double> values;
+  std::string error;
+  bool binned = false;
+  switch (array->GetDataType())
+  {
+    vtkTemplateMacro(const VTK_TT* v = static_cast<const VTK_TT*>(array->GetVoidPointer(0));
+                     binned = BinChannels(v, channels, n, par.Bins, bins, error, SMPParallelFor());
+                     if (binned) { values.assign(v, v + n * channels); });
+    default:
+      error = "the array's value type is not supported.";
+  }
+  if (!binned)
+  {
+    vtkErrorMacro("Voxel Cut: " << error);
+    return 0;
+  }
+  this->UpdateProgress(0.2);
+  MultiLabelParameters multi;
+  multi.Channels = static_cast<featuremesh::ChannelModel>(this->ChannelModel);
+  const MultiLabelResult result =
+    MultiLabelVoxelCut(values, bins, geometry, seeds, par, multi, AlgorithmProgress(this, 0.2, 0.95));
+  if (result.Aborted)
+  {
+    return 1;
+  }
+  if (!result.Error.empty())
+  {
+    vtkErrorMacro("Voxel Cut: " << result.Error);
+    return 0;
+  }
+  vtkImageData* output = vtkImageData::GetData(outputVector, 0);
+  SetImageFrame(output, geometry);
+  vtkNew<vtkUnsignedCharArray> labels;
+  labels->SetName(names::Label);
+  labels->SetNumberOfTuples(n);
+  std::copy(result.Label.begin(), result.Label.end(), labels->GetPointer(0));
+  output->GetPointData()->SetScalars(labels);
+  AddLabelTable(output, result.Labels, this->LabelNames);
+  AddFieldValue(output, names::Sigma, result.Sigma);
+  AddFieldValue(output, names::Energy, result.Energy);
+  AddFieldValue(output, names::ExpansionMoves, result.Moves);
+  AddFieldValue(output, names::ExpansionCycles, result.Cycles);
+  AddFieldValue(output, names::ExpansionSeconds, result.ExpansionSeconds);
+  AddFieldValue(output, names::GeodesicSeconds, result.GeodesicSeconds);
+  AddFieldValue(output, names::TotalSeconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
 void vtkVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
@@ -156,5 +247,8 @@ void vtkVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
      << indent << "GeodesicWeight: " << this->GeodesicWeight << "\n"
      << indent << "GeodesicLength: " << this->GeodesicLength << "\n"
      << indent << "Bandwidth: " << this->Bandwidth << "\n"
-     << indent << "SeedRadius: " << this->SeedRadius << "\n";
+     << indent << "SeedRadius: " << this->SeedRadius << "\n"
+     << indent << "SeedLabelArray: " << this->SeedLabelArray << "\n"
+     << indent << "ChannelModel: " << this->ChannelModel << "\n"
+     << indent << "LabelNames: " << this->LabelNames << "\n";
 }

@@ -15,6 +15,16 @@
 #include "FeatureMeshFiltersModule.h"
 #include "vtkImageAlgorithm.h"
 
+#include <string>
+
+class vtkDataArray;
+namespace featuremesh
+{
+struct ImageGeometry;
+struct LabelledSeeds;
+struct VoxelCutParameters;
+}
+
 class FEATUREMESHFILTERS_EXPORT vtkVoxelCut : public vtkImageAlgorithm
 {
 public:
@@ -51,6 +61,14 @@ public:
   /// Radius (voxels) of the neighbourhood around each seed whose voxels build the histograms. Default 2.
   vtkSetMacro(SeedRadius, double);
   vtkGetMacro(SeedRadius, double);
+  /// With the Seeds input (port 3), as vtkSuperVoxelCut: the label array's name, the channel model,
+  /// the label names.
+  vtkSetStdStringFromCharMacro(SeedLabelArray);
+  vtkGetCharFromStdStringMacro(SeedLabelArray);
+  vtkSetClampMacro(ChannelModel, int, 0, 1);
+  vtkGetMacro(ChannelModel, int);
+  vtkSetStdStringFromCharMacro(LabelNames);
+  vtkGetCharFromStdStringMacro(LabelNames);
 
   void SetObjectSeedsConnection(vtkAlgorithmOutput* o) { this->SetInputConnection(1, o); }
   void SetBackgroundSeedsConnection(vtkAlgorithmOutput* o) { this->SetInputConnection(2, o); }
@@ -73,8 +91,14 @@ protected:
   double GeodesicLength;
   double Bandwidth;
   double SeedRadius;
+  std::string SeedLabelArray;
+  int ChannelModel;
+  std::string LabelNames;
 
 private:
+  int RequestMultiLabel(const featuremesh::LabelledSeeds& seeds, vtkDataArray* array,
+    const featuremesh::ImageGeometry& geometry, const featuremesh::VoxelCutParameters& parameters,
+    vtkInformationVector* outputVector);
   // The pipeline state of the last failed run (0: none), so that it is not repeated.
   vtkMTimeType FailedAt = 0;
   double FailedAtTime = 0.0;

@@ -116,6 +116,15 @@ constexpr const char* SetupSeconds = "SetupSeconds";
 constexpr const char* GraphSeconds = "GraphSeconds";
 constexpr const char* FlowSeconds = "FlowSeconds";
 constexpr const char* GeodesicSeconds = "GeodesicSeconds"; // the seeds' spatial term (Task Object)
+// Multi-label cuts (labelled seeds): the number of labels k + 1 and their names (string array, one
+// per label, empty names when none were given), the Potts energy reached, the expansion moves that
+// lowered it, the cycles over the labels, the alpha-expansion's time.
+constexpr const char* Labels = "Labels";
+constexpr const char* LabelNames = "LabelNames";
+constexpr const char* Energy = "Energy";
+constexpr const char* ExpansionMoves = "ExpansionMoves";
+constexpr const char* ExpansionCycles = "ExpansionCycles";
+constexpr const char* ExpansionSeconds = "ExpansionSeconds";
 constexpr const char* CutTotalSeconds = "CutTotalSeconds";
 } // namespace names
 } // namespace featuremesh

@@ -26,6 +26,8 @@
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
+#include "vtkStringArray.h"
+#include "vtkTable.h"
 #include "vtkTypeTraits.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
@@ -1512,4 +1514,274 @@ TEST(SegmentationSurfaceSmoothing, ZeroIterationsKeepTheCutsBoundary)
       for (int a = 0; a < 3; ++a)
         ASSERT_EQ(m->GetPoint(i)[a], labelled->GetPoint(i)[a]);
   }, [](vtkSegmentationSurfaceSmoothing* f) { f->SetIterations(0); });
+}
+
+//------------------------------------------------------------------------------------------------
+// Labelled seeds (x, y, z, label): several objects by alpha-expansion, several channels.
+namespace
+{
+using Seed = std::array<double, 4>; // voxel i, j, k and the label
+
+// Two discs (100 left, 180 right) on 20, with noise; `components` copies of the value.
+vtkSmartPointer<vtkImageData> TwoDiscs(int components = 1)
+{
+  const Fill noisy = Noisy(0, 0, 0, -1); // background 20 plus noise
+  return Image({ { 64, 48, 1 } },
+    [=](int i, int j, int k) {
+      return noisy(i, j, k) + (std::hypot(i - 18, j - 24) <= 11 ? 80.0 : (std::hypot(i - 46, j - 24) <= 11 ? 160.0 : 0.0));
+    },
+    VTK_FLOAT, components);
+}
+
+std::vector<Seed> ThreeLabels()
+{
+  return { { 18, 24, 0, 1 }, { 16, 22, 0, 1 }, { 46, 24, 0, 2 }, { 48, 26, 0, 2 }, { 3, 3, 0, 0 }, { 60, 44, 0, 0 },
+    { 32, 24, 0, 0 } };
+}
+
+// The seeds as a point set with a Label point array of `type`.
+vtkSmartPointer<vtkPolyData> LabelledPoints(vtkImageData* image, const std::vector<Seed>& seeds, int type = VTK_INT)
+{
+  std::vector<Point> p;
+  for (const auto& s : seeds)
+    p.push_back(World(image, s[0], s[1], s[2]));
+  auto poly = Points(p);
+  vtkSmartPointer<vtkDataArray> label = vtkSmartPointer<vtkDataArray>::Take(vtkDataArray::CreateDataArray(type));
+  label->SetName("Label");
+  for (const auto& s : seeds)
+    label->InsertNextTuple1(s[3]);
+  poly->GetPointData()->AddArray(label);
+  return poly;
+}
+
+// The seeds as a CSV reader gives them: a table with columns x, y, z, label.
+vtkSmartPointer<vtkTable> LabelledTable(vtkImageData* image, const std::vector<Seed>& seeds)
+{
+  auto table = vtkSmartPointer<vtkTable>::New();
+  for (const char* name : { "x", "y", "z", "label" })
+  {
+    vtkNew<vtkDoubleArray> column;
+    column->SetName(name);
+    table->AddColumn(column);
+  }
+  for (const auto& s : seeds)
+  {
+    const Point w = World(image, s[0], s[1], s[2]);
+    table->InsertNextBlankRow();
+    for (int c = 0; c < 4; ++c)
+      table->SetValue(table->GetNumberOfRows() - 1, c, c < 3 ? w[c] : s[3]);
+  }
+  return table;
+}
+
+template <typename Check>
+void LabelledCut(vtkImageData* image, vtkDataObject* seeds, const Check& check,
+  const std::function<void(vtkSuperVoxelCut*)>& set = nullptr, bool withImage = true)
+{
+  auto mesh = MeshOf(image->GetNumberOfScalarComponents() == 1 ? image : TwoDiscs().GetPointer());
+  Run<vtkSuperVoxelCut> cut;
+  cut->SetInputData(0, mesh);
+  if (withImage)
+    cut->SetInputData(3, image);
+  cut->SetInputData(4, seeds);
+  if (set)
+    set(cut.F);
+  cut.Update();
+  check(cut, CutOutputs{ cut->GetOutput(), vtkImageData::SafeDownCast(cut->GetOutputDataObject(2)) });
+}
+
+template <typename Check>
+void LabelledVoxelCut(vtkImageData* image, vtkDataObject* seeds, const Check& check)
+{
+  Run<vtkVoxelCut> cut;
+  cut->SetInputData(0, image);
+  cut->SetInputData(3, seeds);
+  cut.Update();
+  check(cut, cut->GetOutput());
+}
+
+// No error; every seed's voxel has its label; each label 0..2 covers at least `least` voxels.
+template <typename Filter>
+void ExpectLabelled(Run<Filter>& run, vtkImageData* labels, vtkImageData* image, const std::vector<Seed>& seeds,
+  vtkIdType least = 200)
+{
+  ASSERT_TRUE(run.Log->Errors.empty()) << run.Log->All();
+  vtkDataArray* l = labels->GetPointData()->GetScalars();
+  ASSERT_NE(l, nullptr);
+  std::vector<vtkIdType> count(256, 0);
+  for (vtkIdType v = 0; v < l->GetNumberOfTuples(); ++v)
+    ++count[static_cast<int>(l->GetComponent(v, 0))];
+  for (int label = 0; label < 3; ++label)
+    EXPECT_GE(count[label], least) << "label " << label;
+  int dims[3];
+  image->GetDimensions(dims);
+  for (const auto& s : seeds)
+    EXPECT_EQ(l->GetComponent(static_cast<vtkIdType>(s[1]) * dims[0] + static_cast<vtkIdType>(s[0]), 0), s[3]);
+  vtkFieldData* fd = labels->GetFieldData();
+  ASSERT_NE(fd->GetArray("Labels"), nullptr);
+  EXPECT_EQ(fd->GetArray("Labels")->GetComponent(0, 0), 3);
+  EXPECT_NE(fd->GetAbstractArray("LabelNames"), nullptr);
+}
+} // namespace
+
+TEST(SuperVoxelCut, LabelledSeedsThreeLabels)
+{
+  auto image = TwoDiscs();
+  auto seeds = LabelledPoints(image, ThreeLabels());
+  LabelledCut(image, seeds, [&](auto& cut, const CutOutputs& out) {
+    ExpectLabelled(cut, out.Labels, image, ThreeLabels());
+    auto names = vtkStringArray::SafeDownCast(out.Labels->GetFieldData()->GetAbstractArray("LabelNames"));
+    ASSERT_NE(names, nullptr);
+    EXPECT_EQ(names->GetValue(2), "right");
+  }, [](vtkSuperVoxelCut* f) { f->SetLabelNames("background;left;right"); });
+}
+TEST(SuperVoxelCut, LabelledSeedsFromATableGiveThePointSetsLabels)
+{
+  auto image = TwoDiscs();
+  vtkSmartPointer<vtkDataArray> fromPoints;
+  LabelledCut(image, LabelledPoints(image, ThreeLabels()),
+    [&](auto&, const CutOutputs& out) { fromPoints = out.Labels->GetPointData()->GetScalars(); });
+  LabelledCut(image, LabelledTable(image, ThreeLabels()), [&](auto& cut, const CutOutputs& out) {
+    ExpectLabelled(cut, out.Labels, image, ThreeLabels());
+    vtkDataArray* l = out.Labels->GetPointData()->GetScalars();
+    for (vtkIdType v = 0; v < l->GetNumberOfTuples(); ++v)
+      ASSERT_EQ(l->GetComponent(v, 0), fromPoints->GetComponent(v, 0)) << "voxel " << v;
+  });
+}
+TEST(SuperVoxelCut, OneObjectLabelGivesTheBinaryCut)
+{
+  // Labels 0 and 1 on one channel: the binary cut of the two seed ports, label for label.
+  Case2D c;
+  std::vector<Seed> seeds;
+  for (auto [set, label] : { std::pair<vtkPolyData*, int>{ c.object, 1 }, { c.background, 0 } })
+    for (vtkIdType i = 0; i < set->GetNumberOfPoints(); ++i)
+    {
+      double ijk[3];
+      c.image->TransformPhysicalPointToContinuousIndex(set->GetPoint(i), ijk);
+      seeds.push_back({ ijk[0], ijk[1], ijk[2], double(label) });
+    }
+  vtkSmartPointer<vtkDataArray> binary;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image,
+    [&](auto&, const CutOutputs& out) { binary = out.Mesh->GetCellData()->GetArray("Label"); });
+  LabelledCut(c.image, LabelledTable(c.image, seeds), [&](auto& cut, const CutOutputs& out) {
+    ASSERT_TRUE(cut.Log->Errors.empty()) << cut.Log->All();
+    vtkDataArray* l = out.Mesh->GetCellData()->GetArray("Label");
+    ASSERT_EQ(l->GetNumberOfTuples(), binary->GetNumberOfTuples());
+    for (vtkIdType e = 0; e < l->GetNumberOfTuples(); ++e)
+      ASSERT_EQ(l->GetComponent(e, 0), binary->GetComponent(e, 0)) << "element " << e;
+  });
+}
+TEST(SuperVoxelCut, TwoChannels)
+{
+  auto image = TwoDiscs(2);
+  LabelledCut(image, LabelledPoints(image, ThreeLabels()),
+    [&](auto& cut, const CutOutputs& out) { ExpectLabelled(cut, out.Labels, image, ThreeLabels()); });
+}
+TEST(SuperVoxelCut, NaNInOneChannel)
+{
+  auto image = TwoDiscs(2);
+  image->GetPointData()->GetScalars()->SetComponent(100, 1, NaN);
+  LabelledCut(image, LabelledPoints(image, ThreeLabels()), [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "NaN"); });
+}
+TEST(SuperVoxelCut, TwoChannelsWithoutLabelledSeeds)
+{
+  auto image = TwoDiscs(2);
+  auto mesh = MeshOf(TwoDiscs());
+  SuperVoxelCut(mesh, ObjectSeeds(image), BackgroundSeeds(image), image,
+    [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "2 components"); });
+}
+TEST(SuperVoxelCut, LabelBeyond255)
+{
+  auto image = TwoDiscs();
+  auto seeds = ThreeLabels();
+  seeds[2][3] = 256;
+  LabelledCut(image, LabelledPoints(image, seeds), [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "whole numbers"); });
+}
+TEST(SuperVoxelCut, NegativeLabel)
+{
+  auto image = TwoDiscs();
+  auto seeds = ThreeLabels();
+  seeds[2][3] = -1;
+  LabelledCut(image, LabelledPoints(image, seeds), [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "whole numbers"); });
+}
+TEST(SuperVoxelCut, FractionalLabels)
+{
+  auto image = TwoDiscs();
+  auto seeds = ThreeLabels();
+  seeds[2][3] = 1.5;
+  LabelledCut(image, LabelledPoints(image, seeds, VTK_FLOAT), [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "whole numbers"); });
+}
+TEST(SuperVoxelCut, ALabelWithNoSeed)
+{
+  auto image = TwoDiscs();
+  auto seeds = ThreeLabels();
+  seeds[2][3] = seeds[3][3] = 3;
+  LabelledCut(image, LabelledPoints(image, seeds), [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "label 2 has no seed"); });
+}
+TEST(SuperVoxelCut, SeedsOfOneLabelOnly)
+{
+  auto image = TwoDiscs();
+  auto seeds = ThreeLabels();
+  for (auto& s : seeds)
+    s[3] = 1;
+  LabelledCut(image, LabelledPoints(image, seeds), [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "one label only"); });
+}
+TEST(SuperVoxelCut, LabelledSeedsWithoutALabelArray)
+{
+  auto image = TwoDiscs();
+  auto seeds = LabelledPoints(image, ThreeLabels());
+  seeds->GetPointData()->RemoveArray("Label");
+  LabelledCut(image, seeds, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "no one-component numeric array named Label"); });
+}
+TEST(SuperVoxelCut, TwoLabelsInOneElement)
+{
+  auto image = TwoDiscs();
+  auto seeds = ThreeLabels();
+  seeds.push_back({ 18, 24, 0, 2 }); // the voxel of a label-1 seed
+  LabelledCut(image, LabelledPoints(image, seeds), [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "holds seeds of labels"); });
+}
+TEST(SuperVoxelCut, SeveralObjectsWithoutTheImage)
+{
+  auto image = TwoDiscs();
+  LabelledCut(image, LabelledPoints(image, ThreeLabels()), [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "need the Image"); },
+    nullptr, false);
+}
+TEST(SuperVoxelCut, NoSeedsAtAll)
+{
+  Case2D c;
+  ::Run<vtkSuperVoxelCut> cut;
+  cut->SetInputData(0, c.mesh);
+  cut->SetInputData(3, c.image);
+  cut.Update();
+  ExpectCutError(cut, CutOutputs{ cut->GetOutput(), nullptr }, "connect the Object Seeds");
+}
+TEST(VoxelCut, LabelledSeedsThreeLabels)
+{
+  auto image = TwoDiscs();
+  LabelledVoxelCut(image, LabelledTable(image, ThreeLabels()), [&](auto& cut, vtkImageData* out) { ExpectLabelled(cut, out, image, ThreeLabels()); });
+}
+TEST(VoxelCut, LabelledSeedsTwoChannels)
+{
+  auto image = TwoDiscs(2);
+  LabelledVoxelCut(image, LabelledPoints(image, ThreeLabels()), [&](auto& cut, vtkImageData* out) { ExpectLabelled(cut, out, image, ThreeLabels()); });
+}
+TEST(VoxelCut, NaNInOneChannel)
+{
+  auto image = TwoDiscs(2);
+  image->GetPointData()->GetScalars()->SetComponent(100, 1, NaN);
+  LabelledVoxelCut(image, LabelledPoints(image, ThreeLabels()), [](auto& cut, vtkImageData* out) { ExpectError(cut, "NaN", out); });
+}
+TEST(VoxelCut, ALabelWithNoSeed)
+{
+  auto image = TwoDiscs();
+  auto seeds = ThreeLabels();
+  seeds[2][3] = seeds[3][3] = 3;
+  LabelledVoxelCut(image, LabelledPoints(image, seeds), [](auto& cut, vtkImageData* out) { ExpectError(cut, "label 2 has no seed", out); });
+}
+TEST(VoxelCut, NoSeedsAtAll)
+{
+  ::Run<vtkVoxelCut> cut;
+  cut->SetInputData(0, Disc());
+  cut.Update();
+  ExpectError(cut, "connect the Object Seeds", cut->GetOutput());
 }

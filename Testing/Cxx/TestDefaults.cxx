@@ -29,6 +29,15 @@
     }                                                                                              \
   }
 
+#define STRING_GETTER(cls, name)                                                                   \
+  {                                                                                                \
+    #cls "::" #name, []() {                                                                        \
+      vtkNew<cls> filter;                                                                          \
+      const char* value = filter->Get##name();                                                     \
+      return std::string(value ? value : "");                                                      \
+    }                                                                                              \
+  }
+
 int main(int argc, char* argv[])
 {
   if (argc < 2)
@@ -68,10 +77,16 @@ int main(int argc, char* argv[])
     GETTER(vtkVoxelCut, Lambda), GETTER(vtkVoxelCut, Sigma), GETTER(vtkVoxelCut, Bins),
     GETTER(vtkVoxelCut, SeedRadius), GETTER(vtkVoxelCut, Connectivity), GETTER(vtkVoxelCut, Bandwidth),
     GETTER(vtkVoxelCut, Task), GETTER(vtkVoxelCut, GeodesicWeight), GETTER(vtkVoxelCut, GeodesicLength),
+    GETTER(vtkSuperVoxelCut, ChannelModel), GETTER(vtkVoxelCut, ChannelModel),
     GETTER(vtkSegmentationSurfaceSmoothing, Method), GETTER(vtkSegmentationSurfaceSmoothing, Iterations),
     GETTER(vtkSegmentationSurfaceSmoothing, Relaxation), GETTER(vtkSegmentationSurfaceSmoothing, PassBand),
     GETTER(vtkSegmentationSurfaceSmoothing, VolumeMesh), GETTER(vtkSegmentationSurfaceSmoothing, MinAngle),
     GETTER(vtkSegmentationSurfaceSmoothing, MinDihedralAngle), GETTER(vtkSegmentationSurfaceSmoothing, RelaxationRings),
+  };
+  // String properties with a default (array names, label names).
+  const std::map<std::string, std::function<std::string()>> strings = {
+    STRING_GETTER(vtkSuperVoxelCut, SeedLabelArray), STRING_GETTER(vtkSuperVoxelCut, LabelNames),
+    STRING_GETTER(vtkVoxelCut, SeedLabelArray), STRING_GETTER(vtkVoxelCut, LabelNames),
   };
   int failures = 0, checked = 0;
   std::set<std::string> seen;
@@ -97,6 +112,21 @@ int main(int argc, char* argv[])
         const std::string tag = property->GetName();
         const char* command = property->GetAttribute("command");
         const char* value = property->GetAttribute("default_values");
+        if (tag == "StringVectorProperty" && command && std::string(command) != "SetInputArrayToProcess")
+        {
+          const std::string text = value ? value : ""; // the parser drops an empty default
+          const std::string key = cls + "::" + std::string(command).substr(3);
+          seen.insert(key);
+          auto it = strings.find(key);
+          ++checked;
+          if (it == strings.end() || it->second() != text)
+          {
+            std::cout << "FAIL: " << key << ": XML default '" << text << "', C++ default '"
+                      << (it == strings.end() ? std::string("(no getter in this test)") : it->second()) << "'\n";
+            ++failures;
+          }
+          continue;
+        }
         if ((tag != "IntVectorProperty" && tag != "DoubleVectorProperty") || !command || !value)
         {
           continue;
@@ -126,11 +156,16 @@ int main(int argc, char* argv[])
       }
     }
   }
+  std::set<std::string> keys;
   for (const auto& g : getters)
+    keys.insert(g.first);
+  for (const auto& g : strings)
+    keys.insert(g.first);
+  for (const auto& g : keys)
   {
-    if (!seen.count(g.first))
+    if (!seen.count(g))
     {
-      std::cout << "FAIL: " << g.first << " is not a property with a default in the XML\n";
+      std::cout << "FAIL: " << g << " is not a property with a default in the XML\n";
       ++failures;
     }
   }

@@ -22,7 +22,7 @@ DATA = os.environ.get("FEATUREMESH_DATA", os.path.join(ROOT, "Data"))
 SHARED = os.environ.get("FEATUREMESH_SHARED_DATA", os.path.join(os.path.dirname(ROOT), "shared", "data"))
 
 __all__ = ["ROOT", "DATA", "SHARED", "np", "v2n", "find_plugin", "load_plugin", "cases", "case_dir", "seeds", "fetch",
-           "labels", "dice", "case_task", "Case"]
+           "labels", "dice", "case_task", "Case", "multilabel_cases", "MultiLabelCase"]
 
 
 def find_plugin():
@@ -162,3 +162,62 @@ class Case:
         nodes = self.feature_nodes(**properties.get("FeatureNodes", {}))
         mesh = self.mesh(nodes, **properties.get("DelaunayImageMesh", {}))
         return nodes, mesh, self.super_voxel_cut(mesh, **properties.get("SuperVoxelCut", {}))
+
+
+def multilabel_cases(selection=()):
+    """{name: folder} of the multi-label cases (Data/multilabel, then the shared data's multilabel/),
+    filtered by `selection` as cases() does."""
+    if isinstance(selection, str):
+        selection = [c for c in selection.split(",") if c]
+    found = {}
+    for root in (os.path.join(DATA, "multilabel"), os.path.join(SHARED, "multilabel")):
+        for image in sorted(glob.glob(os.path.join(root, "*", "image.mha"))):
+            found.setdefault(os.path.basename(os.path.dirname(image)), os.path.dirname(image))
+    return {k: v for k, v in found.items() if not selection or k in selection}
+
+
+class MultiLabelCase:
+    """A multi-label case folder (image.mha of one or more channels, seeds.csv with x,y,z,label,
+    labels.csv, optional truth.mha). Stages 1-3 run on the first channel; the cuts get every
+    channel and the labelled seeds straight from the CSV reader."""
+
+    def __init__(self, folder, seeds_file=None):
+        self.folder = folder
+        self.name = os.path.basename(os.path.normpath(folder))
+        self.image = ps.OpenDataFile(os.path.join(folder, "image.mha"))
+        self.image.UpdatePipeline()
+        self.array = self.image.PointData.keys()[0]
+        self.channels = self.image.PointData[self.array].GetNumberOfComponents()
+        if self.channels > 1:
+            self.first = ps.ExtractComponent(Input=self.image, InputArray=["POINTS", self.array], Component=0,
+                                             OutputArrayName="Channel0")
+            self.first_scalars = ["POINTS", "Channel0"]
+        else:
+            self.first, self.first_scalars = self.image, ["POINTS", self.array]
+        self.seeds = ps.CSVReader(FileName=[seeds_file or os.path.join(folder, "seeds.csv")])
+        self.names = ["background"]
+        with open(os.path.join(folder, "labels.csv"), newline="") as f:
+            self.names += [row["name"] for row in sorted(csv.DictReader(f), key=lambda r: int(r["label"]))]
+
+    def truth(self):
+        path = os.path.join(self.folder, "truth.mha")
+        return v2n(fetch(ps.OpenDataFile(path)).GetPointData().GetScalars()) if os.path.isfile(path) else None
+
+    def seed_rows(self):
+        """[(x, y, z, label)] of seeds.csv."""
+        with open(os.path.join(self.folder, "seeds.csv"), newline="") as f:
+            return [(float(r["x"]), float(r["y"]), float(r["z"]), int(r["label"])) for r in csv.DictReader(f)]
+
+    def mesh(self, smoothing=True):
+        """Stages 1 -> 2 (-> 3) on the first channel: the main job's pipeline."""
+        nodes = ps.FeatureNodes(Input=self.first, Scalars=self.first_scalars)
+        mesh = ps.DelaunayImageMesh(Nodes=nodes, Image=self.first, Scalars=self.first_scalars)
+        return ps.ImageMeshSmoothing(Mesh=mesh, Image=self.first, Scalars=self.first_scalars) if smoothing else mesh
+
+    def super_voxel_cut(self, mesh, **properties):
+        properties.setdefault("LabelNames", ";".join(self.names))
+        return ps.SuperVoxelCut(Mesh=mesh, Seeds=self.seeds, Image=self.image, Scalars=["POINTS", self.array], **properties)
+
+    def voxel_cut(self, **properties):
+        properties.setdefault("LabelNames", ";".join(self.names))
+        return ps.VoxelCut(Input=self.image, Seeds=self.seeds, Scalars=["POINTS", self.array], **properties)

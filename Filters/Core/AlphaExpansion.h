@@ -1,0 +1,48 @@
+// Alpha-expansion (Boykov, Veksler & Zabih, "Fast approximate energy minimization via graph cuts",
+// PAMI 2001) of a Potts energy on any graph, each move one Boykov-Kolmogorov max-flow:
+//
+//   E(L) = sum_p Cost_p(L_p) + sum_pq Weight_pq [L_p != L_q]
+//
+// A move lets every node keep its label or take label alpha; moves run for alpha = 0..Labels-1 in
+// cycles until a cycle lowers the energy no more. The Potts term is a metric, so each move is the
+// exact optimum among its labellings and the result lies within a factor 2 of the global optimum.
+#pragma once
+
+#include "GraphEdges.h"
+#include "Parallel.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace featuremesh
+{
+struct PottsProblem
+{
+  std::int64_t Nodes = 0;
+  int Labels = 0;               // 2..256
+  const GraphEdges* Edges = nullptr;
+  std::vector<double> Weight;   // per edge, >= 0
+  std::vector<double> Cost;     // Nodes * Labels, node p's cost of label l at p * Labels + l
+  std::vector<std::int16_t> Hard; // per node: -1 free, else the label it must take; empty = none
+};
+
+struct ExpansionResult
+{
+  std::vector<std::uint8_t> Label;
+  double Energy = 0.0;
+  int Moves = 0;  // expansion moves that lowered the energy
+  int Cycles = 0; // passes over the labels
+  std::string Error;
+  bool Aborted = false;
+};
+
+// The energy of `label` (hard constraints not checked).
+double PottsEnergy(const PottsProblem& problem, const std::vector<std::uint8_t>& label);
+
+// From `start` (empty: each node's hard label, else its cheapest), at most `maxCycles` cycles.
+// Every input is checked first (finite costs and weights, edges naming nodes, hard labels in
+// range): a problem is an Error sentence. Progress after each move; an abort leaves Aborted.
+ExpansionResult AlphaExpansion(const PottsProblem& problem, std::vector<std::uint8_t> start,
+  const ProgressFunction& progress = NoProgress(), int maxCycles = 8);
+} // namespace featuremesh

@@ -1,0 +1,802 @@
+#include "MultiLabelCut.h"
+#include "SeedGeodesics.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <numeric>
+
+namespace featuremesh
+{
+namespace
+{
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Percentile of channel c over at most ~1 M evenly strided voxels.
+template <typename T>
+double ChannelPercentile(const T* values, int channels, int c, std::int64_t voxels, double q)
+{
+  const std::int64_t stride = std::max<std::int64_t>(1, voxels / 1000000);
+  std::vector<double> v;
+  v.reserve(static_cast<std::size_t>(voxels / stride + 1));
+  for (std::int64_t i = 0; i < voxels; i += stride)
+  {
+    v.push_back(static_cast<double>(values[i * channels + c]));
+  }
+  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q / 100.0 * static_cast<double>(v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+// A Gaussian blur of `grid` (PerChannel^channels bins) along `axis`, sigma `h` bins, truncated at 3h.
+void BlurAxis(std::vector<double>& grid, int perChannel, int channels, int axis, double h)
+{
+  const int radius = static_cast<int>(std::ceil(3.0 * h));
+  std::vector<double> kernel(2 * radius + 1);
+  for (int i = -radius; i <= radius; ++i)
+  {
+    kernel[i + radius] = std::exp(-0.5 * i * i / (h * h));
+  }
+  std::int64_t stride = 1;
+  for (int a = 0; a < axis; ++a)
+  {
+    stride *= perChannel;
+  }
+  const std::int64_t total = static_cast<std::int64_t>(grid.size());
+  std::vector<double> out(grid.size(), 0.0), line(perChannel);
+  (void)channels;
+  for (std::int64_t start = 0; start < total; ++start)
+  {
+    if ((start / stride) % perChannel != 0)
+    {
+      continue; // not the first bin of a line along `axis`
+    }
+    for (int i = 0; i < perChannel; ++i)
+    {
+      line[i] = grid[start + i * stride];
+    }
+    for (int i = 0; i < perChannel; ++i)
+    {
+      if (line[i] == 0.0)
+      {
+        continue;
+      }
+      for (int d = -radius; d <= radius; ++d)
+      {
+        const int j = i + d;
+        if (j >= 0 && j < perChannel)
+        {
+          out[start + j * stride] += line[i] * kernel[d + radius];
+        }
+      }
+    }
+  }
+  grid.swap(out);
+}
+
+// Silverman's bandwidth in bins of the samples `counts` along `axis` (d dimensions).
+double Bandwidth(const std::vector<double>& counts, int perChannel, int axis, int d, double factor)
+{
+  std::int64_t stride = 1;
+  for (int a = 0; a < axis; ++a)
+  {
+    stride *= perChannel;
+  }
+  double n = 0.0, sum = 0.0, sum2 = 0.0;
+  for (std::size_t b = 0; b < counts.size(); ++b)
+  {
+    const double x = static_cast<double>((static_cast<std::int64_t>(b) / stride) % perChannel);
+    n += counts[b];
+    sum += counts[b] * x;
+    sum2 += counts[b] * x * x;
+  }
+  if (n <= 0.0)
+  {
+    return 1.0;
+  }
+  const double mean = sum / n, sd = std::sqrt(std::max(0.0, sum2 / n - mean * mean));
+  return std::max(1.0, factor * 1.06 * sd * std::pow(n, -1.0 / (d + 4)));
+}
+
+// -ln of a normalised density mixed with 1 % uniform.
+std::vector<double> NegativeLog(std::vector<double> density)
+{
+  const double total = std::accumulate(density.begin(), density.end(), 0.0);
+  const double uniform = 1.0 / static_cast<double>(density.size());
+  for (double& p : density)
+  {
+    p = -std::log(0.99 * (total > 0.0 ? p / total : uniform) + 0.01 * uniform);
+  }
+  return density;
+}
+
+// The seeds' nodes: hard[p] = label or -1; false with a sentence when two labels share a node.
+bool LabelConstraints(const LabelledSeeds& seeds, const std::function<std::int64_t(std::int64_t)>& node,
+  std::int64_t nodes, const char* what, std::vector<std::int16_t>& hard, std::string& error)
+{
+  hard.assign(nodes, -1);
+  for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
+  {
+    const std::int64_t p = node(seeds.Voxel[s]);
+    if (p < 0)
+    {
+      error = "a seed lies outside the mesh.";
+      return false;
+    }
+    if (hard[p] >= 0 && hard[p] != seeds.Label[s])
+    {
+      error = std::string(what) + " " + std::to_string(p) + " holds seeds of labels " + std::to_string(hard[p]) + " and " +
+        std::to_string(seeds.Label[s]) + "; move one of them.";
+      return false;
+    }
+    hard[p] = seeds.Label[s];
+  }
+  return true;
+}
+
+// Boundary weights contact * exp(-|dm|^2 / 2 sigma^2) over the edges, sigma automatic (RMS) when <= 0.
+std::vector<double> PottsWeights(const GraphEdges& edges, const std::vector<double>& mean, int channels,
+  const std::vector<double>& contact, double& sigma)
+{
+  auto d2 = [&](std::int64_t a, std::int64_t b) {
+    double s = 0.0;
+    for (int c = 0; c < channels; ++c)
+    {
+      const double d = mean[a * channels + c] - mean[b * channels + c];
+      s += d * d;
+    }
+    return s;
+  };
+  if (sigma <= 0.0)
+  {
+    double ss = 0.0;
+    edges.ForEach([&](std::int64_t, std::int64_t a, std::int64_t b) { ss += d2(a, b); });
+    sigma = edges.Size() ? std::sqrt(ss / static_cast<double>(edges.Size())) : 1.0;
+    sigma = sigma > 0.0 ? sigma : 1.0;
+  }
+  const double inv2s2 = 1.0 / (2.0 * sigma * sigma);
+  std::vector<double> w(edges.Size());
+  edges.ForEach([&](std::int64_t e, std::int64_t a, std::int64_t b) {
+    const double s = d2(a, b);
+    w[e] = (contact.empty() ? 1.0 : contact[e]) * (s == 0.0 ? 1.0 : std::exp(-s * inv2s2));
+  });
+  return w;
+}
+
+// Adds the seeds' geodesic spatial term for L labels to `cost` (nodes x L), each node's share
+// weighted by lambda * size; `cache` keeps each label's distances while its seed nodes stay.
+bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, const ChannelBins& bins,
+  const std::vector<double>* step, const std::vector<std::int16_t>& hard, int L, const SeedGeodesicParameters& geo,
+  double lambda, const std::vector<double>& size, std::vector<double>& cost, const ProgressFunction& progress,
+  MultiLabelCache* cache)
+{
+  const std::int64_t n = static_cast<std::int64_t>(hard.size());
+  const int channels = bins.Channels;
+  // One value per node: the channels in units of their ranges, summed.
+  std::vector<double> value(n, 0.0);
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    for (int c = 0; c < channels; ++c)
+    {
+      value[p] += mean[p * channels + c] / (bins.Width[c] * bins.PerChannel);
+    }
+  }
+  GeodesicGraph graph;
+  graph.Edges = &edges;
+  graph.Value = value.data();
+  graph.Nodes = n;
+  graph.Step = step;
+  std::vector<std::uint8_t> kind(n);
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    kind[p] = static_cast<std::uint8_t>(hard[p] + 1);
+  }
+  const bool keep = cache && cache->Hard.size() == hard.size() && static_cast<int>(cache->Distance.size()) == L;
+  std::vector<std::vector<double>> distance(L);
+  for (int l = 0; l < L; ++l)
+  {
+    bool same = keep;
+    for (std::int64_t p = 0; same && p < n; ++p)
+    {
+      same = (cache->Hard[p] == l) == (hard[p] == l);
+    }
+    if (same && static_cast<std::int64_t>(cache->Distance[l].size()) == n)
+    {
+      distance[l] = cache->Distance[l];
+      continue;
+    }
+    distance[l] = GeodesicDistances(graph, kind, static_cast<std::uint8_t>(l + 1), 1.0, geo.LengthWeight,
+      SubProgress(progress, static_cast<double>(l) / L, static_cast<double>(l + 1) / L));
+    if (distance[l].empty())
+    {
+      return false;
+    }
+  }
+  const double mix = 0.01;
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    double total = 0.0;
+    int zeros = 0;
+    for (int l = 0; l < L; ++l)
+    {
+      const double d = distance[l][p];
+      zeros += d == 0.0;
+      total += d > 0.0 && std::isfinite(d) ? 1.0 / d : 0.0;
+    }
+    const double s = lambda * (size.empty() ? 1.0 : size[p]);
+    for (int l = 0; l < L; ++l)
+    {
+      const double d = distance[l][p];
+      const double share = zeros ? (d == 0.0 ? 1.0 / zeros : 0.0)
+                                 : (total > 0.0 ? (std::isfinite(d) ? 1.0 / d / total : 0.0) : 1.0 / L);
+      cost[p * L + l] += s * -geo.Weight * std::log(mix + (1.0 - L * mix) * share);
+    }
+  }
+  if (cache)
+  {
+    cache->Distance = std::move(distance);
+    cache->Hard = hard;
+  }
+  return true;
+}
+
+// Adds to samples[label] the bins of the voxels within `radius` of each seed voxel.
+void SeedBallSamples(const LabelledSeeds& seeds, const ChannelBins& bins, const ImageGeometry& g, double radius,
+  std::vector<std::vector<double>>& samples)
+{
+  const int rad = static_cast<int>(std::floor(radius));
+  const int rk = g.Is2D() ? 0 : rad;
+  for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
+  {
+    const std::int64_t v = seeds.Voxel[s];
+    const int k = static_cast<int>(v / g.SliceStride());
+    const int j = static_cast<int>((v % g.SliceStride()) / g.Dims[0]);
+    const int i = static_cast<int>(v % g.Dims[0]);
+    for (int dk = -rk; dk <= rk; ++dk)
+      for (int dj = -rad; dj <= rad; ++dj)
+        for (int di = -rad; di <= rad; ++di)
+        {
+          if (di * di + dj * dj + dk * dk <= radius * radius && g.Contains(i + di, j + dj, k + dk))
+          {
+            samples[seeds.Label[s]][bins.Bin[g.Index(i + di, j + dj, k + dk)]] += 1.0;
+          }
+        }
+  }
+}
+
+int LabelCount(const LabelledSeeds& seeds)
+{
+  int top = 0;
+  for (std::uint8_t l : seeds.Label)
+  {
+    top = std::max<int>(top, l);
+  }
+  return top + 1;
+}
+
+std::string CheckSeeds(const LabelledSeeds& seeds)
+{
+  std::vector<double> labels(seeds.Label.begin(), seeds.Label.end());
+  return ValidateSeedLabels(labels);
+}
+} // namespace
+
+int ChannelBins::Count() const
+{
+  int c = 1;
+  for (int i = 0; i < this->Channels; ++i)
+  {
+    c *= this->PerChannel;
+  }
+  return c;
+}
+
+int BinsPerChannel(int channels, int bins)
+{
+  int b = bins > 0 ? bins : 64;
+  while (b > 2 && std::pow(static_cast<double>(b), channels) > 4096.0)
+  {
+    --b;
+  }
+  return b;
+}
+
+template <typename T>
+bool BinChannels(const T* values, int channels, std::int64_t voxels, int bins, ChannelBins& out, std::string& error,
+  const ParallelFor& parallel)
+{
+  out = ChannelBins();
+  if (channels < 1 || channels > 12 || voxels <= 0)
+  {
+    error = "the image needs 1 to 12 components and at least one voxel.";
+    return false;
+  }
+  std::int64_t bad = 0;
+  for (std::int64_t i = 0; i < voxels * channels; ++i)
+  {
+    const double v = static_cast<double>(values[i]);
+    bad += !(std::isfinite(v) && std::fabs(v) <= 1e150);
+  }
+  if (bad)
+  {
+    error = std::to_string(bad) + " image values are NaN, infinite or beyond +-1e150; replace them (e.g. with a Calculator) first.";
+    return false;
+  }
+  out.Channels = channels;
+  out.PerChannel = BinsPerChannel(channels, bins);
+  for (int c = 0; c < channels; ++c)
+  {
+    const double low = ChannelPercentile(values, channels, c, voxels, 0.5);
+    double high = ChannelPercentile(values, channels, c, voxels, 99.5);
+    high = high > low ? high : low + 1.0;
+    out.Low.push_back(low);
+    out.Width.push_back((high - low) / out.PerChannel);
+  }
+  out.Bin.resize(voxels);
+  const int per = out.PerChannel;
+  parallel(voxels, 65536, [&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t v = b; v < e; ++v)
+    {
+      int index = 0, stride = 1;
+      for (int c = 0; c < channels; ++c)
+      {
+        const double q = (static_cast<double>(values[v * channels + c]) - out.Low[c]) / out.Width[c];
+        const int k = q < 1.0 ? 0 : (q >= per - 1 ? per - 1 : static_cast<int>(q));
+        index += k * stride;
+        stride *= per;
+      }
+      out.Bin[v] = static_cast<std::uint16_t>(index);
+    }
+  });
+  return true;
+}
+
+template <typename T>
+void NodeChannelMeans(const std::int32_t* owner, const T* values, int channels, std::int64_t voxels, std::int64_t nodes,
+  std::vector<double>& mean, std::vector<double>& count)
+{
+  mean.assign(nodes * channels, 0.0);
+  count.assign(nodes, 0.0);
+  for (std::int64_t v = 0; v < voxels; ++v)
+  {
+    const std::int32_t p = owner[v];
+    if (p >= 0)
+    {
+      count[p] += 1.0;
+      for (int c = 0; c < channels; ++c)
+      {
+        mean[p * channels + c] += static_cast<double>(values[v * channels + c]);
+      }
+    }
+  }
+  for (std::int64_t p = 0; p < nodes; ++p)
+  {
+    for (int c = 0; c < channels && count[p] > 0.0; ++c)
+    {
+      mean[p * channels + c] /= count[p];
+    }
+  }
+}
+
+#define FEATUREMESH_CHANNELS(T)                                                                                          \
+  template bool BinChannels<T>(const T*, int, std::int64_t, int, ChannelBins&, std::string&, const ParallelFor&);       \
+  template void NodeChannelMeans<T>(const std::int32_t*, const T*, int, std::int64_t, std::int64_t, std::vector<double>&, \
+    std::vector<double>&);
+FEATUREMESH_CHANNELS(float)
+FEATUREMESH_CHANNELS(double)
+FEATUREMESH_CHANNELS(char)
+FEATUREMESH_CHANNELS(signed char)
+FEATUREMESH_CHANNELS(unsigned char)
+FEATUREMESH_CHANNELS(short)
+FEATUREMESH_CHANNELS(unsigned short)
+FEATUREMESH_CHANNELS(int)
+FEATUREMESH_CHANNELS(unsigned int)
+FEATUREMESH_CHANNELS(long)
+FEATUREMESH_CHANNELS(unsigned long)
+FEATUREMESH_CHANNELS(long long)
+FEATUREMESH_CHANNELS(unsigned long long)
+
+NodeBinRuns GroupNodeBins(const std::int32_t* owner, const ChannelBins& bins, std::int64_t nodes)
+{
+  const std::int64_t voxels = static_cast<std::int64_t>(bins.Bin.size());
+  std::vector<std::int64_t> start(nodes + 1, 0);
+  for (std::int64_t v = 0; v < voxels; ++v)
+  {
+    if (owner[v] >= 0)
+    {
+      ++start[owner[v] + 1];
+    }
+  }
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::uint16_t> sorted(start[nodes]);
+  std::vector<std::int64_t> cursor(start.begin(), start.end() - 1);
+  for (std::int64_t v = 0; v < voxels; ++v)
+  {
+    if (owner[v] >= 0)
+    {
+      sorted[cursor[owner[v]]++] = bins.Bin[v];
+    }
+  }
+  NodeBinRuns runs;
+  runs.Offset.assign(nodes + 1, 0);
+  for (std::int64_t p = 0; p < nodes; ++p)
+  {
+    std::sort(sorted.begin() + start[p], sorted.begin() + start[p + 1]);
+    for (std::int64_t i = start[p]; i < start[p + 1]; ++i)
+    {
+      if (i == start[p] || sorted[i] != sorted[i - 1])
+      {
+        runs.Bin.push_back(sorted[i]);
+        runs.Count.push_back(0);
+      }
+      ++runs.Count.back();
+    }
+    runs.Offset[p + 1] = static_cast<std::int64_t>(runs.Bin.size());
+  }
+  return runs;
+}
+
+std::vector<std::vector<double>> LabelCosts(const std::vector<std::vector<double>>& counts, const ChannelBins& bins,
+  ChannelModel model, double bandwidth)
+{
+  const int n = bins.Channels, per = bins.PerChannel;
+  std::vector<std::vector<double>> cost;
+  for (const std::vector<double>& count : counts)
+  {
+    if (model == ChannelModel::Joint || n == 1)
+    {
+      std::vector<double> density = count;
+      for (int c = 0; c < n; ++c)
+      {
+        BlurAxis(density, per, n, c, Bandwidth(count, per, c, n, bandwidth));
+      }
+      cost.push_back(NegativeLog(std::move(density)));
+      continue;
+    }
+    // Independent: one blurred marginal per channel; a bin's cost is the sum of its channels'.
+    std::vector<std::vector<double>> marginal(n, std::vector<double>(per, 0.0));
+    for (std::size_t b = 0; b < count.size(); ++b)
+    {
+      std::int64_t rest = static_cast<std::int64_t>(b);
+      for (int c = 0; c < n; ++c, rest /= per)
+      {
+        marginal[c][rest % per] += count[b];
+      }
+    }
+    for (int c = 0; c < n; ++c)
+    {
+      BlurAxis(marginal[c], per, 1, 0, Bandwidth(marginal[c], per, 0, 1, bandwidth));
+      marginal[c] = NegativeLog(std::move(marginal[c]));
+    }
+    std::vector<double> sum(count.size(), 0.0);
+    for (std::size_t b = 0; b < count.size(); ++b)
+    {
+      std::int64_t rest = static_cast<std::int64_t>(b);
+      for (int c = 0; c < n; ++c, rest /= per)
+      {
+        sum[b] += marginal[c][rest % per];
+      }
+    }
+    cost.push_back(std::move(sum));
+  }
+  return cost;
+}
+
+std::string ValidateSeedLabels(const std::vector<double>& labels)
+{
+  std::vector<char> seen(256, 0);
+  for (double l : labels)
+  {
+    if (!(l >= 0.0 && l <= 255.0) || l != std::floor(l))
+    {
+      return "a seed label is " + std::to_string(l) + "; labels are whole numbers from 0 (background) to 255.";
+    }
+    seen[static_cast<int>(l)] = 1;
+  }
+  int top = 255;
+  while (top > 0 && !seen[top])
+  {
+    --top;
+  }
+  if (std::count(seen.begin(), seen.end(), 1) < 2)
+  {
+    return "the seeds hold one label only; give seeds of the background (0) and of at least one object (1..k).";
+  }
+  for (int l = 0; l <= top; ++l)
+  {
+    if (!seen[l])
+    {
+      return "label " + std::to_string(l) + " has no seed; number the labels 0 (background) to " + std::to_string(top) +
+        " without gaps.";
+    }
+  }
+  return std::string();
+}
+
+std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>& label, const GraphEdges& edges,
+  const std::vector<double>& weight, const std::vector<std::int16_t>& hard, const std::vector<std::uint8_t>& border)
+{
+  if (mode == Connectivity::Off)
+  {
+    return 0;
+  }
+  const std::int64_t n = static_cast<std::int64_t>(label.size());
+  std::int64_t changed = 0;
+  // A dropped component may border only dropped ones: a second pass takes what the first settled.
+  for (int pass = 0; pass < 3; ++pass)
+  {
+    std::int64_t count = 0;
+    const std::vector<std::int64_t> comp = LabelComponents(label, edges, count);
+    std::vector<std::uint8_t> seeded(count, 0), touches(count, 0);
+    for (std::int64_t p = 0; p < n; ++p)
+    {
+      seeded[comp[p]] |= hard[p] == label[p];
+      touches[comp[p]] |= border[p];
+    }
+    std::vector<std::uint8_t> drop(count, 0);
+    std::int64_t any = 0;
+    for (std::int64_t p = 0; p < n; ++p)
+    {
+      const std::int64_t c = comp[p];
+      const bool d = !seeded[c] &&
+        ((label[p] == 0 && !touches[c]) || (label[p] != 0 && mode == Connectivity::SeededObject));
+      drop[c] = d;
+      any += d;
+    }
+    if (!any)
+    {
+      break;
+    }
+    // Per dropped component, the shared weight with each kept neighbouring label.
+    std::map<std::pair<std::int64_t, int>, double> shared;
+    edges.ForEach([&](std::int64_t e, std::int64_t a, std::int64_t b) {
+      const std::int64_t ca = comp[a], cb = comp[b];
+      if (ca == cb)
+      {
+        return;
+      }
+      const double w = weight.empty() ? 1.0 : weight[e] + 1e-300;
+      if (drop[ca] && !drop[cb])
+      {
+        shared[{ ca, label[b] }] += w;
+      }
+      if (drop[cb] && !drop[ca])
+      {
+        shared[{ cb, label[a] }] += w;
+      }
+    });
+    std::vector<int> to(count, -1);
+    std::vector<double> best(count, -1.0);
+    for (const auto& s : shared)
+    {
+      if (s.second > best[s.first.first])
+      {
+        best[s.first.first] = s.second;
+        to[s.first.first] = s.first.second;
+      }
+    }
+    std::int64_t moved = 0;
+    for (std::int64_t p = 0; p < n; ++p)
+    {
+      const int t = to[comp[p]];
+      if (drop[comp[p]] && t >= 0 && t != label[p])
+      {
+        label[p] = static_cast<std::uint8_t>(t);
+        ++moved;
+      }
+    }
+    changed += moved;
+    if (!moved)
+    {
+      break;
+    }
+  }
+  return changed;
+}
+
+MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutData& data, const ChannelBins& bins,
+  const NodeBinRuns& runs, const std::vector<double>& mean, const std::vector<double>& count, const LabelledSeeds& seeds,
+  const SuperVoxelCutParameters& par, const MultiLabelParameters& multi, const ParallelFor& parallel,
+  const ProgressFunction& progress, MultiLabelCache* cache)
+{
+  const auto t0 = Clock::now();
+  MultiLabelResult r;
+  const std::int64_t n = mesh.NumberOfElements();
+  r.Error = CheckSeeds(seeds);
+  if (r.Error.empty() && (static_cast<std::int64_t>(runs.Offset.size()) != n + 1 ||
+                           static_cast<std::int64_t>(mean.size()) != n * bins.Channels ||
+                           static_cast<std::int64_t>(count.size()) != n ||
+                           static_cast<std::int64_t>(data.Owner.size()) != mesh.Geometry().Size()))
+  {
+    r.Error = "the voxel owners or channel statistics do not match the mesh.";
+  }
+  if (r.Error.empty())
+  {
+    r.Error = ValidateParameters(par);
+  }
+  if (!r.Error.empty())
+  {
+    return r;
+  }
+  const int L = r.Labels = LabelCount(seeds);
+  std::vector<std::int16_t> hard;
+  if (!LabelConstraints(
+        seeds, [&](std::int64_t v) { return static_cast<std::int64_t>(data.Owner[v]); }, n, "element", hard, r.Error))
+  {
+    return r;
+  }
+  // Samples: the voxels of the seed elements, or those within SeedRadius of each seed.
+  std::vector<std::vector<double>> samples(L, std::vector<double>(bins.Count(), 0.0));
+  if (!par.SampleSeedElements)
+  {
+    SeedBallSamples(seeds, bins, mesh.Geometry(), par.SeedRadius, samples);
+  }
+  for (std::int64_t p = 0; p < n && par.SampleSeedElements; ++p)
+  {
+    if (hard[p] >= 0)
+    {
+      for (std::int64_t k = runs.Offset[p]; k < runs.Offset[p + 1]; ++k)
+      {
+        samples[hard[p]][runs.Bin[k]] += runs.Count[k];
+      }
+    }
+  }
+  const std::vector<std::vector<double>> costs = LabelCosts(samples, bins, multi.Channels, par.Bandwidth);
+  PottsProblem pr;
+  pr.Nodes = n;
+  pr.Labels = L;
+  const std::shared_ptr<const FaceAdjacency> faces = mesh.SharedFaces();
+  const GraphEdges edges(faces->A, faces->B, faces);
+  pr.Edges = &edges;
+  pr.Cost.assign(n * L, 0.0);
+  parallel(n, 16384, [&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t p = b; p < e; ++p)
+    {
+      for (std::int64_t k = runs.Offset[p]; k < runs.Offset[p + 1]; ++k)
+      {
+        for (int l = 0; l < L; ++l)
+        {
+          pr.Cost[p * L + l] += par.Lambda * runs.Count[k] * costs[l][runs.Bin[k]];
+        }
+      }
+    }
+  });
+  if (par.Task == Task::Object && par.Geodesic.Weight > 0.0)
+  {
+    const auto g0 = Clock::now();
+    const std::vector<double> step = data.CentreSteps.size() == faces->A.size() ? data.CentreSteps : CentreDistances(mesh, *faces);
+    if (!AddGeodesicCosts(edges, mean, bins, &step, hard, L, par.Geodesic, par.Lambda, count, pr.Cost,
+          SubProgress(progress, 0.0, 0.2), cache))
+    {
+      r.Aborted = true;
+      return r;
+    }
+    r.GeodesicSeconds = Since(g0);
+  }
+  r.Sigma = par.Sigma;
+  pr.Weight = PottsWeights(edges, mean, bins.Channels, ContactInVoxelFaces(mesh, par.ScaleByContact), r.Sigma);
+  pr.Hard = hard;
+  r.SetupSeconds = Since(t0);
+  const auto t1 = Clock::now();
+  std::vector<std::uint8_t> start;
+  if (cache && static_cast<std::int64_t>(cache->Label.size()) == n)
+  {
+    start = cache->Label;
+    for (std::uint8_t& l : start)
+    {
+      l = l < L ? l : 0;
+    }
+  }
+  ExpansionResult x = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.2, 0.95), multi.MaxCycles);
+  r.ExpansionSeconds = Since(t1);
+  if (!x.Error.empty() || x.Aborted)
+  {
+    r.Error = x.Error;
+    r.Aborted = x.Aborted;
+    return r;
+  }
+  if (cache)
+  {
+    cache->Label = x.Label;
+  }
+  r.Energy = x.Energy;
+  r.Moves = x.Moves;
+  r.Cycles = x.Cycles;
+  r.Label = std::move(x.Label);
+  std::vector<std::uint8_t> border(n, 0);
+  for (std::int64_t e : faces->HullElement)
+  {
+    border[e] = 1;
+  }
+  r.ConnectivityChanged =
+    ApplyLabelConnectivity(ConnectivityFor(par.Connectivity, par.Task), r.Label, edges, pr.Weight, hard, border);
+  r.BoundaryFaces = LabelBoundaryFaces(mesh, *faces, r.Label);
+  return r;
+}
+
+MultiLabelResult MultiLabelVoxelCut(const std::vector<double>& values, const ChannelBins& bins, const ImageGeometry& g,
+  const LabelledSeeds& seeds, const VoxelCutParameters& par, const MultiLabelParameters& multi,
+  const ProgressFunction& progress)
+{
+  const auto t0 = Clock::now();
+  MultiLabelResult r;
+  const std::int64_t n = g.Size();
+  r.Error = CheckSeeds(seeds);
+  if (r.Error.empty() && (static_cast<std::int64_t>(bins.Bin.size()) != n ||
+                           static_cast<std::int64_t>(values.size()) != n * bins.Channels))
+  {
+    r.Error = "the channel values do not match the image.";
+  }
+  if (r.Error.empty())
+  {
+    r.Error = ValidateParameters(par);
+  }
+  if (!r.Error.empty())
+  {
+    return r;
+  }
+  const int L = r.Labels = LabelCount(seeds);
+  std::vector<std::int16_t> hard;
+  if (!LabelConstraints(seeds, [](std::int64_t v) { return v; }, n, "voxel", hard, r.Error))
+  {
+    return r;
+  }
+  std::vector<std::vector<double>> samples(L, std::vector<double>(bins.Count(), 0.0));
+  SeedBallSamples(seeds, bins, g, par.SeedRadius, samples);
+  const std::vector<std::vector<double>> costs = LabelCosts(samples, bins, multi.Channels, par.Bandwidth);
+  PottsProblem pr;
+  pr.Nodes = n;
+  pr.Labels = L;
+  const GraphEdges edges = GraphEdges::Grid(g.Dims[0], g.Dims[1], g.Dims[2]);
+  pr.Edges = &edges;
+  pr.Cost.resize(n * L);
+  for (std::int64_t v = 0; v < n; ++v)
+  {
+    for (int l = 0; l < L; ++l)
+    {
+      pr.Cost[v * L + l] = par.Lambda * costs[l][bins.Bin[v]];
+    }
+  }
+  if (par.Task == Task::Object && par.Geodesic.Weight > 0.0)
+  {
+    const auto g0 = Clock::now();
+    if (!AddGeodesicCosts(edges, values, bins, nullptr, hard, L, par.Geodesic, par.Lambda, {}, pr.Cost,
+          SubProgress(progress, 0.0, 0.2), nullptr))
+    {
+      r.Aborted = true;
+      return r;
+    }
+    r.GeodesicSeconds = Since(g0);
+  }
+  r.Sigma = par.Sigma;
+  pr.Weight = PottsWeights(edges, values, bins.Channels, {}, r.Sigma);
+  pr.Hard = hard;
+  r.SetupSeconds = Since(t0);
+  const auto t1 = Clock::now();
+  ExpansionResult x = AlphaExpansion(pr, {}, SubProgress(progress, 0.2, 0.95), multi.MaxCycles);
+  r.ExpansionSeconds = Since(t1);
+  if (!x.Error.empty() || x.Aborted)
+  {
+    r.Error = x.Error;
+    r.Aborted = x.Aborted;
+    return r;
+  }
+  r.Energy = x.Energy;
+  r.Moves = x.Moves;
+  r.Cycles = x.Cycles;
+  r.Label = std::move(x.Label);
+  std::vector<std::uint8_t> border(n, 0);
+  for (int k = 0; k < g.Dims[2]; ++k)
+    for (int j = 0; j < g.Dims[1]; ++j)
+      for (int i = 0; i < g.Dims[0]; ++i)
+      {
+        border[g.Index(i, j, k)] = i == 0 || j == 0 || i + 1 == g.Dims[0] || j + 1 == g.Dims[1] ||
+          (!g.Is2D() && (k == 0 || k + 1 == g.Dims[2]));
+      }
+  r.ConnectivityChanged =
+    ApplyLabelConnectivity(ConnectivityFor(par.Connectivity, par.Task), r.Label, edges, pr.Weight, hard, border);
+  return r;
+}
+} // namespace featuremesh

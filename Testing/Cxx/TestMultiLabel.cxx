@@ -1,0 +1,404 @@
+// Multi-label cuts: alpha-expansion, labelled seeds, several channels (MultiLabelCut.h).
+#include "AlphaExpansion.h"
+#include "DelaunayMesh.h"
+#include "ElementRasterizer.h"
+#include "MultiLabelCut.h"
+#include "SimplexMesh.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <thread>
+
+using namespace featuremesh;
+
+namespace
+{
+ImageGeometry Grid(int nx, int ny)
+{
+  ImageGeometry g;
+  g.Dims = { { nx, ny, 1 } };
+  return g;
+}
+
+// Reverse-ordered small chunks on two threads: any split of the loops.
+const ParallelFor TwoThreads = [](std::int64_t n, std::int64_t, const RangeFunction& body) {
+  std::thread t([&] {
+    for (std::int64_t b = 0; b < n / 2; b += 5)
+      body(b, std::min(n / 2, b + 5));
+  });
+  for (std::int64_t b = n / 2; b < n; b += 7)
+    body(b, std::min(n, b + 7));
+  t.join();
+};
+
+// An image of `channels` interleaved channels on a 2D grid; value(i, j, c).
+template <typename F>
+std::vector<float> Image(const ImageGeometry& g, int channels, F value)
+{
+  std::vector<float> v(g.Size() * channels);
+  for (int j = 0; j < g.Dims[1]; ++j)
+    for (int i = 0; i < g.Dims[0]; ++i)
+      for (int c = 0; c < channels; ++c)
+        v[g.Index(i, j, 0) * channels + c] = value(i, j, c);
+  return v;
+}
+
+// The mesh of a 2-pixel lattice (and the last row and column), with everything a cut needs.
+struct Lattice
+{
+  SimplexMesh Mesh;
+  SuperVoxelCutData Data;
+  ChannelBins Bins;
+  NodeBinRuns Runs;
+  std::vector<double> Mean, Count;
+  bool Make(const ImageGeometry& g, const std::vector<float>& image, int channels)
+  {
+    std::vector<std::array<double, 3>> pts;
+    for (int j = 0; j < g.Dims[1]; j += 2)
+      for (int i = 0; i < g.Dims[0]; i += 2)
+        pts.push_back({ { double(i), double(j), 0.0 } });
+    for (int j = 0; j < g.Dims[1]; ++j)
+      pts.push_back({ { double(g.Dims[0] - 1), double(j), 0.0 } });
+    for (int i = 0; i < g.Dims[0]; ++i)
+      pts.push_back({ { double(i), double(g.Dims[1] - 1), 0.0 } });
+    std::sort(pts.begin(), pts.end());
+    pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+    const DelaunayResult d = Triangulate2D(pts);
+    if (!d.Error.empty())
+      return false;
+    this->Mesh = SimplexMesh(g, d.Points, d.Cells, d.VerticesPerCell);
+    this->Mesh.OrientPositively();
+    std::string error;
+    if (!PrepareVoxelOwners(this->Mesh, this->Data, SerialFor()) ||
+      !BinChannels(image.data(), channels, g.Size(), 0, this->Bins, error, SerialFor()))
+      return false;
+    NodeChannelMeans(this->Data.Owner.data(), image.data(), channels, g.Size(), this->Mesh.NumberOfElements(), this->Mean, this->Count);
+    this->Runs = GroupNodeBins(this->Data.Owner.data(), this->Bins, this->Mesh.NumberOfElements());
+    return true;
+  }
+  // The labels on the pixel grid.
+  std::vector<std::uint8_t> Cut(const LabelledSeeds& seeds, const SuperVoxelCutParameters& par,
+    const MultiLabelParameters& multi = MultiLabelParameters(), const ParallelFor& parallel = SerialFor(),
+    MultiLabelResult* out = nullptr)
+  {
+    const MultiLabelResult r = MultiLabelSuperVoxelCut(this->Mesh, this->Data, this->Bins, this->Runs, this->Mean, this->Count,
+      seeds, par, multi, parallel);
+    EXPECT_TRUE(r.Error.empty()) << r.Error;
+    std::vector<std::uint8_t> pixels(this->Mesh.Geometry().Size(), 0);
+    if (r.Error.empty())
+      VoxelLabels(this->Data.Owner, r.Label, pixels.data(), SerialFor());
+    if (out)
+      *out = r;
+    return pixels;
+  }
+};
+
+std::vector<std::uint8_t> VoxelCutLabels(const ImageGeometry& g, const std::vector<float>& image, int channels,
+  const LabelledSeeds& seeds, const VoxelCutParameters& par, const MultiLabelParameters& multi = MultiLabelParameters())
+{
+  ChannelBins bins;
+  std::string error;
+  EXPECT_TRUE(BinChannels(image.data(), channels, g.Size(), 0, bins, error, SerialFor())) << error;
+  const MultiLabelResult r = MultiLabelVoxelCut(std::vector<double>(image.begin(), image.end()), bins, g, seeds, par, multi);
+  EXPECT_TRUE(r.Error.empty()) << r.Error;
+  return r.Label;
+}
+
+// Three vertical plateaus 10 / 50 / 90 with noise, labels 0 / 1 / 2, seeds in each.
+struct Plateaus
+{
+  ImageGeometry G = Grid(60, 40);
+  std::vector<float> Image;
+  LabelledSeeds Seeds;
+  static int Truth(int i) { return i < 20 ? 0 : (i < 40 ? 1 : 2); }
+  Plateaus()
+  {
+    std::mt19937 rng(3);
+    std::normal_distribution<float> noise(0.f, 6.f);
+    this->Image = ::Image(this->G, 1, [&](int i, int, int) { return 10.f + 40.f * Truth(i) + noise(rng); });
+    for (int l = 0; l < 3; ++l)
+      for (int j : { 8, 20, 32 })
+      {
+        this->Seeds.Voxel.push_back(this->G.Index(10 + 20 * l, j, 0));
+        this->Seeds.Label.push_back(static_cast<std::uint8_t>(l));
+      }
+  }
+  double Correct(const std::vector<std::uint8_t>& label) const
+  {
+    std::int64_t right = 0;
+    for (int j = 0; j < this->G.Dims[1]; ++j)
+      for (int i = 0; i < this->G.Dims[0]; ++i)
+        right += label[this->G.Index(i, j, 0)] == Truth(i);
+    return static_cast<double>(right) / this->G.Size();
+  }
+};
+} // namespace
+
+TEST(AlphaExpansion, TwoLabelsReachTheGlobalMinimumAndThreeStayWithinTwice)
+{
+  // Brute force over every labelling of a 3 x 3 grid: two labels, one expansion move is the exact
+  // binary cut; three labels, the expansion's bound (factor 2 for Potts).
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const GraphEdges edges = GraphEdges::Grid(3, 3, 1);
+  for (int labels : { 2, 3 })
+    for (int trial = 0; trial < 20; ++trial)
+    {
+      PottsProblem pr;
+      pr.Nodes = 9;
+      pr.Labels = labels;
+      pr.Edges = &edges;
+      for (std::int64_t e = 0; e < edges.Size(); ++e)
+        pr.Weight.push_back(u(rng));
+      for (int i = 0; i < 9 * labels; ++i)
+        pr.Cost.push_back(2.0 * u(rng));
+      double best = 1e300;
+      std::vector<std::uint8_t> l(9, 0);
+      int total = 1;
+      for (int i = 0; i < 9; ++i)
+        total *= labels;
+      for (int code = 0; code < total; ++code)
+      {
+        for (int i = 0, c = code; i < 9; ++i, c /= labels)
+          l[i] = static_cast<std::uint8_t>(c % labels);
+        best = std::min(best, PottsEnergy(pr, l));
+      }
+      const ExpansionResult r = AlphaExpansion(pr, {});
+      ASSERT_TRUE(r.Error.empty()) << r.Error;
+      EXPECT_NEAR(r.Energy, PottsEnergy(pr, r.Label), 1e-9);
+      if (labels == 2)
+        EXPECT_NEAR(r.Energy, best, 1e-9) << "trial " << trial;
+      else
+        EXPECT_LE(r.Energy, 2.0 * best + 1e-9) << "trial " << trial;
+      // Each move is an exact optimum: no expansion of the result lowers its energy.
+      for (int alpha = 0; alpha < labels; ++alpha)
+        for (int subset = 0; subset < 512; ++subset)
+        {
+          std::vector<std::uint8_t> moved = r.Label;
+          for (int i = 0; i < 9; ++i)
+            if (subset >> i & 1)
+              moved[i] = static_cast<std::uint8_t>(alpha);
+          EXPECT_GE(PottsEnergy(pr, moved), r.Energy - 1e-9) << "trial " << trial << " alpha " << alpha;
+        }
+    }
+}
+
+TEST(AlphaExpansion, HardLabelsHold)
+{
+  // Costs pull every node to label 0; the hard nodes keep 1 and 2.
+  const GraphEdges edges = GraphEdges::Grid(5, 5, 1);
+  PottsProblem pr;
+  pr.Nodes = 25;
+  pr.Labels = 3;
+  pr.Edges = &edges;
+  pr.Weight.assign(edges.Size(), 1.0);
+  for (int p = 0; p < 25; ++p)
+    pr.Cost.insert(pr.Cost.end(), { 0.0, 5.0, 5.0 });
+  pr.Hard.assign(25, -1);
+  pr.Hard[6] = 1;
+  pr.Hard[18] = 2;
+  const ExpansionResult r = AlphaExpansion(pr, {});
+  ASSERT_TRUE(r.Error.empty());
+  EXPECT_EQ(r.Label[6], 1);
+  EXPECT_EQ(r.Label[18], 2);
+  EXPECT_EQ(std::count(r.Label.begin(), r.Label.end(), 0), 23);
+}
+
+TEST(AlphaExpansion, BadProblemsAreErrors)
+{
+  const GraphEdges edges = GraphEdges::Grid(2, 2, 1);
+  PottsProblem pr;
+  pr.Nodes = 4;
+  pr.Labels = 2;
+  pr.Edges = &edges;
+  pr.Weight.assign(edges.Size(), 1.0);
+  pr.Cost.assign(8, 0.0);
+  pr.Cost[3] = std::nan("");
+  EXPECT_FALSE(AlphaExpansion(pr, {}).Error.empty());
+  pr.Cost[3] = 0.0;
+  pr.Weight[0] = -1.0;
+  EXPECT_FALSE(AlphaExpansion(pr, {}).Error.empty());
+  pr.Weight[0] = 1.0;
+  pr.Hard = { -1, 2, -1, -1 };
+  EXPECT_FALSE(AlphaExpansion(pr, {}).Error.empty());
+  pr.Labels = 1;
+  EXPECT_FALSE(AlphaExpansion(pr, {}).Error.empty());
+}
+
+TEST(MultiLabel, ThreePlateausAreTheLabelsOnVoxelsAndElements)
+{
+  const Plateaus p;
+  Lattice m;
+  ASSERT_TRUE(m.Make(p.G, p.Image, 1));
+  VoxelCutParameters vp;
+  SuperVoxelCutParameters sp;
+  for (Task task : { Task::Object, Task::Class })
+  {
+    vp.Task = sp.Task = task;
+    const std::vector<std::uint8_t> voxel = VoxelCutLabels(p.G, p.Image, 1, p.Seeds, vp);
+    const std::vector<std::uint8_t> super = m.Cut(p.Seeds, sp);
+    EXPECT_GT(p.Correct(voxel), 0.99);
+    // Elements of the 2-pixel lattice straddle each plateau edge by a pixel.
+    EXPECT_GT(p.Correct(super), 0.97);
+    for (std::size_t s = 0; s < p.Seeds.Voxel.size(); ++s)
+    {
+      EXPECT_EQ(voxel[p.Seeds.Voxel[s]], p.Seeds.Label[s]);
+      EXPECT_EQ(super[p.Seeds.Voxel[s]], p.Seeds.Label[s]);
+    }
+  }
+}
+
+TEST(MultiLabel, TheSameLabelsOnAnyThreads)
+{
+  const Plateaus p;
+  Lattice m;
+  ASSERT_TRUE(m.Make(p.G, p.Image, 1));
+  const SuperVoxelCutParameters sp;
+  MultiLabelResult serial, threaded;
+  m.Cut(p.Seeds, sp, MultiLabelParameters(), SerialFor(), &serial);
+  m.Cut(p.Seeds, sp, MultiLabelParameters(), TwoThreads, &threaded);
+  EXPECT_EQ(serial.Label, threaded.Label);
+  EXPECT_EQ(serial.Energy, threaded.Energy);
+}
+
+TEST(MultiLabel, TheSecondChannelTellsTheLabelsApart)
+{
+  // Channel 0 is the same noise everywhere; channel 1 tells three bands apart. With both channels
+  // (either model) the labels are the bands; with channel 0 alone they cannot be.
+  const ImageGeometry g = Grid(60, 40);
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0.f, 5.f);
+  const std::vector<float> two = Image(g, 2, [&](int i, int, int c) {
+    return c == 0 ? 50.f + noise(rng) : 10.f + 40.f * Plateaus::Truth(i) + noise(rng);
+  });
+  std::vector<float> first(g.Size());
+  for (std::int64_t v = 0; v < g.Size(); ++v)
+    first[v] = two[2 * v];
+  const Plateaus p;
+  VoxelCutParameters vp;
+  vp.Task = Task::Class; // appearance and boundary alone
+  SuperVoxelCutParameters sp;
+  sp.Task = Task::Class;
+  for (ChannelModel model : { ChannelModel::Joint, ChannelModel::Independent })
+  {
+    MultiLabelParameters multi;
+    multi.Channels = model;
+    EXPECT_GT(p.Correct(VoxelCutLabels(g, two, 2, p.Seeds, vp, multi)), 0.98);
+    Lattice m;
+    ASSERT_TRUE(m.Make(g, two, 2));
+    EXPECT_GT(p.Correct(m.Cut(p.Seeds, sp, multi)), 0.95);
+  }
+  EXPECT_LT(p.Correct(VoxelCutLabels(g, first, 1, p.Seeds, vp)), 0.8);
+  Lattice m;
+  ASSERT_TRUE(m.Make(g, first, 1));
+  EXPECT_LT(p.Correct(m.Cut(p.Seeds, sp)), 0.8);
+}
+
+TEST(MultiLabel, TwoObjectsThatLookAlikeTakeTheirSeedsLabels)
+{
+  // Two disks of one intensity with labels 1 and 2 (left and right kidney, say): by appearance
+  // either label fits either disk; each takes its seeds' label.
+  const ImageGeometry g = Grid(70, 40);
+  std::mt19937 rng(9);
+  std::normal_distribution<float> noise(0.f, 4.f);
+  auto disk = [](int i, int j) { return std::hypot(i - 18, j - 20) < 10 ? 1 : (std::hypot(i - 52, j - 20) < 10 ? 2 : 0); };
+  const std::vector<float> image = Image(g, 1, [&](int i, int j, int) { return (disk(i, j) ? 80.f : 20.f) + noise(rng); });
+  LabelledSeeds seeds;
+  for (auto s : { std::array<int, 3>{ 18, 20, 1 }, { 52, 20, 2 }, { 2, 2, 0 }, { 67, 37, 0 }, { 35, 20, 0 } })
+  {
+    seeds.Voxel.push_back(g.Index(s[0], s[1], 0));
+    seeds.Label.push_back(static_cast<std::uint8_t>(s[2]));
+  }
+  VoxelCutParameters vp;
+  const std::vector<std::uint8_t> label = VoxelCutLabels(g, image, 1, seeds, vp);
+  std::int64_t right = 0;
+  for (int j = 0; j < 40; ++j)
+    for (int i = 0; i < 70; ++i)
+      right += label[g.Index(i, j, 0)] == disk(i, j);
+  EXPECT_GT(static_cast<double>(right) / g.Size(), 0.99);
+}
+
+TEST(MultiLabel, TheGeodesicTermFindsWhatTheHistogramsCannot)
+{
+  // A faint ring whose inside looks like its outside, label 1 seeded on a small brighter blob at its
+  // centre (2 noise deviations above), and a bright square (label 2) outside it. By appearance the inside is background and
+  // label 1 shrinks to its blob; with the spatial term label 1 is the ring's inside, on the voxel
+  // grid and on the elements. Connectivity off.
+  const int n = 64;
+  const ImageGeometry g = Grid(n, n);
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0.f, 1.f);
+  auto radius = [&](int i, int j) { return std::hypot(i - n / 2, j - n / 2); };
+  auto square = [](int i, int j) { return i >= 1 && i <= 8 && j >= 28 && j <= 36; };
+  const std::vector<float> image = Image(g, 1, [&](int i, int j, int) {
+    return (square(i, j) ? 100.f : (radius(i, j) >= 20 && radius(i, j) <= 22 ? 40.f : (radius(i, j) < 3 ? 62.f : 60.f))) +
+      noise(rng);
+  });
+  LabelledSeeds seeds;
+  for (auto s : { std::array<int, 3>{ n / 2, n / 2, 1 }, { 4, 32, 2 }, { 2, 2, 0 }, { n - 3, n - 3, 0 }, { 2, n - 3, 0 },
+         { n - 3, 2, 0 } })
+  {
+    seeds.Voxel.push_back(g.Index(s[0], s[1], 0));
+    seeds.Label.push_back(static_cast<std::uint8_t>(s[2]));
+  }
+  auto filled = [&](const std::vector<std::uint8_t>& label) {
+    std::int64_t inside = 0, one = 0;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        if (radius(i, j) < 19.5)
+        {
+          ++inside;
+          one += label[g.Index(i, j, 0)] == 1;
+        }
+    return static_cast<double>(one) / inside;
+  };
+  Lattice m;
+  ASSERT_TRUE(m.Make(g, image, 1));
+  for (double weight : { 0.0, SeedGeodesicParameters().Weight })
+  {
+    VoxelCutParameters vp;
+    vp.Connectivity = Connectivity::Off;
+    vp.Geodesic.Weight = weight;
+    SuperVoxelCutParameters sp;
+    sp.Connectivity = Connectivity::Off;
+    sp.Geodesic.Weight = weight;
+    const std::vector<std::uint8_t> voxel = VoxelCutLabels(g, image, 1, seeds, vp);
+    const std::vector<std::uint8_t> super = m.Cut(seeds, sp);
+    for (const auto* label : { &voxel, &super })
+    {
+      if (weight > 0)
+        EXPECT_GT(filled(*label), 0.97) << (label == &super ? "elements" : "voxels");
+      else
+        EXPECT_LT(filled(*label), 0.1) << (label == &super ? "elements" : "voxels");
+    }
+  }
+}
+
+TEST(MultiLabel, ConnectivityGivesAnUnseededPieceToItsNeighbour)
+{
+  // A row 0 0 2 2 1 1 1 0 0 with seeds of 1 (node 5) and 0 (nodes 0, 8): the piece of 2 holds no
+  // seed of 2, and shares more weight with label 1 than with 0, so Seeded Object makes it 1.
+  const GraphEdges edges = GraphEdges::Grid(9, 1, 1);
+  std::vector<std::uint8_t> label{ 0, 0, 2, 2, 1, 1, 1, 0, 0 };
+  std::vector<double> weight{ 1.0, 0.2, 1.0, 0.9, 1.0, 1.0, 1.0, 1.0 };
+  std::vector<std::int16_t> hard{ 0, -1, -1, -1, -1, 1, -1, -1, 0 };
+  const std::vector<std::uint8_t> border{ 1, 0, 0, 0, 0, 0, 0, 0, 1 };
+  EXPECT_EQ(ApplyLabelConnectivity(Connectivity::FillHoles, label, edges, weight, hard, border), 0);
+  EXPECT_EQ(ApplyLabelConnectivity(Connectivity::SeededObject, label, edges, weight, hard, border), 2);
+  EXPECT_EQ(label, (std::vector<std::uint8_t>{ 0, 0, 1, 1, 1, 1, 1, 0, 0 }));
+}
+
+TEST(MultiLabel, SeedLabelsAreChecked)
+{
+  EXPECT_TRUE(ValidateSeedLabels({ 0, 1, 2, 2, 0 }).empty());
+  EXPECT_FALSE(ValidateSeedLabels({ 0, -1, 1 }).empty());
+  EXPECT_FALSE(ValidateSeedLabels({ 0, 256, 1 }).empty());
+  EXPECT_FALSE(ValidateSeedLabels({ 0, 1.5 }).empty());
+  EXPECT_FALSE(ValidateSeedLabels({ 0, 1, 3 }).empty()); // label 2 has no seed
+  EXPECT_FALSE(ValidateSeedLabels({ 1, 1 }).empty());    // no background
+  EXPECT_FALSE(ValidateSeedLabels({ 0, 0 }).empty());    // no object
+  EXPECT_FALSE(ValidateSeedLabels({ 0, std::nan("") }).empty());
+}
