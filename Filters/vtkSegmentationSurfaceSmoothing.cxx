@@ -19,6 +19,7 @@
 #include "vtkUnstructuredGrid.h"
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 
 vtkStandardNewMacro(vtkSegmentationSurfaceSmoothing);
@@ -107,10 +108,10 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
     for (vtkIdType c = 0; c < nCells; ++c)
     {
       const double l = labelArray->GetComponent(c, 0);
-      if (l != 0.0 && l != 1.0)
+      if (!(l >= 0.0 && l <= 255.0 && l == std::floor(l)))
       {
         return fail("the Label cell array holds " + std::to_string(l) +
-          "; it must be 0 (background) or 1 (object), as the Super-Voxel Cut writes it.");
+          "; it must be 0 (background) or a whole number 1..255 (objects), as the Super-Voxel Cut writes it.");
       }
       label[c] = static_cast<std::uint8_t>(l);
     }

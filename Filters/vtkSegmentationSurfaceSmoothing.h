@@ -3,14 +3,15 @@
  * @brief   Smooths a segmentation's boundary and moves its labelled mesh with it (FeatureMesh stage 6).
  *
  * Input "Labelled Mesh": the Super-Voxel Cut's first output (triangles or tetrahedra with the cell
- * array Label, 0 background / 1 object, and the image frame in field data). Output 0: the boundary
- * between object and background (2D polylines, 3D a closed outward triangle surface) at its smoothed
+ * array Label, 0 background / 1..k objects, and the image frame in field data). Output 0: the boundary
+ * between the labels (2D polylines, 3D triangles; one closed outward surface for one object) at its smoothed
  * positions: Laplacian (the thesis, 3 iterations of relaxation 0.5) or Taubin (no shrinkage).
  * Output 1: the labelled mesh whose nodes followed the boundary, every element positively oriented
  * and above its quality floor, labels unchanged, quality arrays recomputed and the stale image
  * statistics dropped; its boundary nodes are output 0's points. Point array Shortfall: how far a
  * boundary node stopped from its smoothed position. Nodes on the image box stay
- * on it. See Filters/Core/SurfaceSmoothing.h.
+ * on it. With several objects, junction curves (three labels) move along themselves and junction
+ * points stay. See Filters/Core/SurfaceSmoothing.h.
  */
 #ifndef vtkSegmentationSurfaceSmoothing_h
 #define vtkSegmentationSurfaceSmoothing_h

@@ -1,8 +1,8 @@
 """FeatureMesh main job (pvpython / pvbatch): image + seeds -> [RSP edges ->] nodes -> mesh -> smoothed mesh -> super-voxel cut
 -> smoothed segmentation surface and a labelled FEM mesh.
 
-usage: pvpython featuremesh_segment.py IMAGE --object-seeds CSV --background-seeds CSV [--truth LABELS]
-                                       [--out DIR] [--plugin FeatureMesh.so]
+usage: pvpython featuremesh_segment.py IMAGE (--object-seeds CSV --background-seeds CSV | --seeds CSV [--labels CSV])
+                                       [--truth LABELS] [--out DIR] [--plugin FeatureMesh.so]
                                        [--task object|class] [--lambda L] [--connectivity task|off|fill|seeded]
                                        [--sigma S] [--bins B]
                                        [--no-smoothing] [--rsp] [--surface-method laplacian|taubin]
@@ -10,7 +10,11 @@ usage: pvpython featuremesh_segment.py IMAGE --object-seeds CSV --background-see
 --rsp runs RSP Edge Enhancement first and feeds its edge map to Feature Nodes (seed-aware nodes: fine
 at the seeded object's boundary, coarse away from it; writes DIR/<name>_edge_confidence.vti too).
 The cut's options default to the Super-Voxel Cut's own defaults (see its properties in ParaView).
-Seeds: CSV files with columns x,y,z in world coordinates, or "x,y,z;x,y,z" on the command line.
+Seeds: CSV files with columns x,y,z in world coordinates, or "x,y,z;x,y,z" on the command line; or
+--seeds, one CSV with columns x,y,z,label (0 background, 1..k objects: k objects by alpha-expansion,
+on every channel of the image; stages 1-3 run on its first channel) and --labels, a CSV with columns
+label,name (the FEM regions and pair tags take the names). With a truth image of labels 0..k the
+report gives Dice per label.
 Writes DIR/<name>_mesh.vtu (the cut's labelled mesh), _boundary.vtp (the smoothed boundary),
 _labels.vti, _fem.vtu (the labelled mesh with the smoothed interface) and the same mesh for FEM codes:
 _fem.msh (Gmsh 2.2), _fem.mesh (Medit), _fem.inp (Abaqus), _fem.exo (Exodus II), with region and
@@ -45,8 +49,10 @@ def cells_of(grid):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("image")
-    ap.add_argument("--object-seeds", required=True)
-    ap.add_argument("--background-seeds", required=True)
+    ap.add_argument("--object-seeds")
+    ap.add_argument("--background-seeds")
+    ap.add_argument("--seeds", help="labelled seeds: CSV with columns x,y,z,label (instead of the two seed files)")
+    ap.add_argument("--labels", help="label names: CSV with columns label,name (with --seeds)")
     ap.add_argument("--truth")
     ap.add_argument("--out", default="out")
     ap.add_argument("--plugin")
@@ -70,6 +76,8 @@ def main():
     ap.add_argument("--unit", default="mm", help="the image spacing's unit, written where a format has a place for it "
                                                   "(MetaImage and NRRD do not record it; default mm)")
     args = ap.parse_args()
+    if not args.seeds and not (args.object_seeds and args.background_seeds):
+        ap.error("give --object-seeds and --background-seeds, or --seeds")
     fm.load_plugin(args.plugin, ns=globals())
     os.makedirs(args.out, exist_ok=True)
     name = os.path.basename(os.path.dirname(os.path.abspath(args.image))) if os.path.basename(args.image).startswith("image.") else os.path.splitext(os.path.basename(args.image))[0]
@@ -80,17 +88,35 @@ def main():
     image = ps.OpenDataFile(args.image)
     image.UpdatePipeline()
     times["read"] = time.perf_counter() - t
-    so, sb = fm.seeds(args.object_seeds), fm.seeds(args.background_seeds)
-    so.UpdatePipeline()
-    sb.UpdatePipeline()
+    array = image.PointData.keys()[0]
+    channels = image.PointData[array].GetNumberOfComponents()
+    # Stages 1-3 see one channel; the cut sees them all.
+    first = ExtractComponent(Input=image, InputArray=["POINTS", array], Component=0, OutputArrayName="Channel0") \
+        if channels > 1 else image
+    scalars = ["POINTS", "Channel0" if channels > 1 else array]
+    if args.seeds:
+        labelled_seeds = ps.CSVReader(FileName=[os.path.abspath(args.seeds)])
+        so = sb = None
+        names = fm.label_names_from_csv(args.labels) if args.labels else None
+        if args.rsp:
+            raise SystemExit("--rsp takes --object-seeds and --background-seeds")
+    else:
+        so, sb = fm.seeds(args.object_seeds), fm.seeds(args.background_seeds)
+        so.UpdatePipeline()
+        sb.UpdatePipeline()
     rsp = RSPEdgeEnhancement(Input=image, ObjectSeeds=so, BackgroundSeeds=sb) if args.rsp else None
-    nodes = FeatureNodes(Input=image, EdgeMap=rsp) if args.rsp else FeatureNodes(Input=image)
-    delaunay = DelaunayImageMesh(Nodes=nodes, Image=image)
-    mesh = delaunay if args.no_smoothing else ImageMeshSmoothing(Mesh=delaunay, Image=image)
+    nodes = FeatureNodes(Input=first, Scalars=scalars, EdgeMap=rsp) if args.rsp else FeatureNodes(Input=first, Scalars=scalars)
+    delaunay = DelaunayImageMesh(Nodes=nodes, Image=first, Scalars=scalars)
+    mesh = delaunay if args.no_smoothing else ImageMeshSmoothing(Mesh=delaunay, Image=first, Scalars=scalars)
     options = {name: value for name, value in (("Lambda", args.lam), ("Sigma", args.sigma), ("Bins", args.bins),
                ("Connectivity", CONNECTIVITY.get(args.connectivity)), ("Task", TASK.get(args.task)))
                if value is not None}
-    cut = SuperVoxelCut(Mesh=mesh, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, **options)
+    if args.seeds:
+        if names:
+            options["LabelNames"] = ";".join(names)
+        cut = SuperVoxelCut(Mesh=mesh, Seeds=labelled_seeds, Image=image, Scalars=["POINTS", array], **options)
+    else:
+        cut = SuperVoxelCut(Mesh=mesh, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, **options)
     stages = ([("rsp_edge_enhancement", rsp)] if args.rsp else []) + [("feature_nodes", nodes), ("delaunay_image_mesh", delaunay)]
     stages += [] if args.no_smoothing else [("image_mesh_smoothing", mesh)]
     surface_options = {name: value for name, value in (("Method", SURFACE_METHOD.get(args.surface_method)),
@@ -134,13 +160,16 @@ def main():
               # Minimum, 1st percentile of the element minima, maximum: angles (2D) or dihedral angles (3D).
               "angles_degrees": angles, "smoothing": not args.no_smoothing, "rsp": args.rsp,
               "added_nodes": int(field.get("AddedNodes", 0)) if not args.no_smoothing else 0,
-              "object_elements": int(v2n(labelled.GetCellData().GetArray("Label")).sum()),
+              "object_elements": int((v2n(labelled.GetCellData().GetArray("Label")) > 0).sum()),
               "task": cut.GetProperty("Task").GetData(), "lambda": float(cut.Lambda),
               "connectivity": cut.GetProperty("Connectivity").GetData(),
               "sigma": field.get("Sigma"), "flow": field.get("Flow"),
+              "labels": int(field.get("Labels", 2)), "expansion_moves": field.get("ExpansionMoves"),
+              "energy": field.get("Energy"),
               "object_components": int(field.get("ObjectComponents", 0)),
               # World units (the image spacing's unit, squared in 2D, cubed in 3D), largest first.
-              "object_component_volumes": [float(v) for v in v2n(fd.GetArray("ObjectComponentVolumes"))],
+              "object_component_volumes": [float(v) for v in v2n(fd.GetArray("ObjectComponentVolumes"))]
+              if fd.GetArray("ObjectComponentVolumes") else None,
               "surface_smoothing": {"method": smooth.GetProperty("Method").GetData(), "iterations": int(smooth.Iterations),
                                     "boundary_nodes": int(smoothing["BoundaryNodes"]), "short_nodes": int(smoothing["ShortNodes"]),
                                     "pinched_nodes": int(smoothing["PinchedNodes"]),
@@ -152,9 +181,15 @@ def main():
               "fem": dict(fem.report(fem_mesh), unit=args.unit, files=fem_files)}
     if args.truth:
         truth = ps.OpenDataFile(args.truth)
-        T = v2n(sm.Fetch(truth).GetPointData().GetScalars()).astype(bool)
-        L = v2n(labels.GetPointData().GetScalars()).astype(bool)
-        report["dice"] = float(fm.dice(L, T))
+        T = v2n(sm.Fetch(truth).GetPointData().GetScalars())
+        L = v2n(labels.GetPointData().GetScalars())
+        if T.max() > 1:
+            region = fem.label_names(fem_mesh, L)
+            report["dice_per_label"] = {region.get(k, "label_%d" % k): float(fm.dice(L == k, T == k))
+                                        for k in range(1, int(T.max()) + 1)}
+            report["dice"] = float(sum(report["dice_per_label"].values()) / len(report["dice_per_label"]))
+        else:
+            report["dice"] = float(fm.dice(L.astype(bool), T.astype(bool)))
     with open(base + "_report.json", "w") as f:
         json.dump(report, f, indent=2)
     quality_picture(report["fem"], "dihedral" if labels.GetDimensions()[2] > 1 else "element", base + "_quality.png")
@@ -174,6 +209,20 @@ def main():
         b.AmbientColor = b.DiffuseColor = [1.0, 0.2, 0.2]
         b.LineWidth = 2
         b.Position = [0, 0, 1]
+    elif int(field.get("Labels", 2)) > 2:
+        # Several objects: each label's elements in its own colour, with a categorical legend.
+        objects = ps.Threshold(Input=ps.OutputPort(smooth, 1), Scalars=["CELLS", "Label"], LowerThreshold=1,
+                               UpperThreshold=255)
+        b = ps.Show(objects, view)
+        ps.ColorBy(b, ("CELLS", "Label"))
+        lut = ps.GetColorTransferFunction("Label")
+        region = fem.label_names(fem_mesh, v2n(fem_mesh.GetCellData().GetArray("Label")))
+        lut.InterpretValuesAsCategories = 1
+        lut.Annotations = [str(v) for k in sorted(region) if k > 0 for v in (k, region[k])]
+        lut.ApplyPreset("Brewer Qualitative Set1", True)
+        b.SetScalarBarVisibility(view, True)
+        view.CameraPosition = [1, -2, 1.2]
+        view.CameraViewUp = [0, 0, 1]
     else:
         b = ps.Show(ps.OutputPort(smooth, 0), view)
         b.ColorArrayName = ['POINTS', '']
@@ -191,8 +240,11 @@ def main():
     print("mesh quality (%s angles, deg): Delaunay min %.2f / 1st pct %.2f / max %.2f -> %s min %.2f / 1st pct %.2f / max %.2f" % (
         "dihedral" if dims[2] > 1 else "element", angles["delaunay"]["min"], angles["delaunay"]["p1"], angles["delaunay"]["max"],
         "Delaunay" if args.no_smoothing else "smoothed", angles["final"]["min"], angles["final"]["p1"], angles["final"]["max"]))
-    print("object: %d component(s), volumes %s%s" % (len(volumes), ", ".join("%.4g" % v for v in volumes[:5]),
-                                                    ", ..." if len(volumes) > 5 else ""))
+    if volumes is not None:
+        print("object: %d component(s), volumes %s%s" % (len(volumes), ", ".join("%.4g" % v for v in volumes[:5]),
+                                                        ", ..." if len(volumes) > 5 else ""))
+    if "dice_per_label" in report:
+        print("Dice per label:", ", ".join("%s %.3f" % kv for kv in report["dice_per_label"].items()))
     ss = report["surface_smoothing"]
     print("surface smoothing (%s, %d iterations): object %s %+.2f %%, %d of %d boundary nodes short of their smoothed position"
           % (ss["method"], ss["iterations"], "volume" if dims[2] > 1 else "area", 100 * ss["measure_change"],

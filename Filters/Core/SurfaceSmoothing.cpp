@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <unordered_map>
 
 namespace featuremesh
@@ -178,6 +179,123 @@ Boundary BoundaryGraph(std::int64_t nPoints, const std::vector<std::int64_t>& fa
   pairs.resize(6 * interfaceFaces);
   b.InterfaceNeighbours = RowsFromPairs(n, pairs);
   return b;
+}
+
+// With several labels, where three or more meet. Each interface face carries the pair of labels it
+// separates; a boundary edge (3D) whose interface faces carry two or more pairs lies on a junction
+// curve. A node on exactly two junction edges moves along the curve (the mean of those two
+// neighbours); a node on one or more than two is a junction point (a curve's end, a branching, a
+// curve meeting the box) and stays. In 2D a node where interfaces of two or more pairs meet is a
+// junction point. Box faces carry no pair: where an interface meets the box its rim moves within
+// the box as in the binary case.
+struct Junctions
+{
+  std::vector<std::uint8_t> Fixed, OnCurve;
+  CompressedRows Curve;
+};
+
+Junctions JunctionGraph(const SimplexMesh& mesh, const std::vector<std::uint8_t>& label, const Boundary& b,
+  std::int64_t interfaceFaces)
+{
+  const std::int64_t n = static_cast<std::int64_t>(b.Node.size());
+  const int vpc = mesh.VerticesPerCell(), faceSize = vpc - 1;
+  // The label pair of every interface face, by its sorted mesh point ids.
+  std::map<std::array<std::int64_t, 3>, int> pairOf;
+  const FaceAdjacency& adj = mesh.Faces();
+  for (std::size_t f = 0; f < adj.A.size(); ++f)
+  {
+    const int la = label[adj.A[f]], lb = label[adj.B[f]];
+    if (la != lb)
+    {
+      std::array<std::int64_t, 3> key{ { -1, -1, -1 } };
+      for (int k = 1; k < vpc; ++k)
+      {
+        key[k - 1] = mesh.Cell(adj.A[f])[(adj.LocalA[f] + k) % vpc];
+      }
+      std::sort(key.begin(), key.begin() + faceSize);
+      pairOf[key] = 256 * std::min(la, lb) + std::max(la, lb);
+    }
+  }
+  // (edge, pair) of each interface face's edges (3D) or nodes (2D), in local ids.
+  std::vector<std::array<std::int64_t, 3>> incidence;
+  for (std::int64_t f = 0; f < interfaceFaces; ++f)
+  {
+    const std::int64_t* local = &b.Faces[faceSize * f];
+    std::array<std::int64_t, 3> key{ { -1, -1, -1 } };
+    for (int k = 0; k < faceSize; ++k)
+    {
+      key[k] = b.Node[local[k]];
+    }
+    std::sort(key.begin(), key.begin() + faceSize);
+    const auto it = pairOf.find(key);
+    if (it == pairOf.end())
+    {
+      continue; // an unshared face off the box
+    }
+    for (int k = 0; k < faceSize; ++k)
+    {
+      if (faceSize == 2)
+      {
+        incidence.push_back({ { local[k], -1, it->second } });
+      }
+      else
+      {
+        const auto e = std::minmax(local[k], local[(k + 1) % 3]);
+        incidence.push_back({ { e.first, e.second, it->second } });
+      }
+    }
+  }
+  std::sort(incidence.begin(), incidence.end());
+  Junctions j;
+  j.Fixed.assign(n, 0);
+  j.OnCurve.assign(n, 0);
+  std::vector<std::pair<std::int64_t, std::int64_t>> pairs;
+  for (std::size_t i = 0; i < incidence.size();)
+  {
+    std::size_t k = i;
+    int distinct = 0;
+    for (; k < incidence.size() && incidence[k][0] == incidence[i][0] && incidence[k][1] == incidence[i][1]; ++k)
+    {
+      distinct += k == i || incidence[k][2] != incidence[k - 1][2];
+    }
+    if (distinct >= 2)
+    {
+      if (faceSize == 2)
+      {
+        j.Fixed[incidence[i][0]] = 1;
+      }
+      else
+      {
+        pairs.emplace_back(incidence[i][0], incidence[i][1]);
+        pairs.emplace_back(incidence[i][1], incidence[i][0]);
+      }
+    }
+    i = k;
+  }
+  j.Curve = RowsFromPairs(n, pairs);
+  for (std::int64_t v = 0; v < n && faceSize == 3; ++v)
+  {
+    j.OnCurve[v] = j.Curve.Size(v) == 2;
+    j.Fixed[v] = j.Curve.Size(v) > 0 && j.Curve.Size(v) != 2;
+  }
+  return j;
+}
+
+// Measure (area 2D, volume 3D; frame units) of the elements with a label other than 0.
+double LabelledMeasure(const SimplexMesh& mesh, const std::vector<V3>& frame, const std::vector<std::uint8_t>& label)
+{
+  double sum = 0.0;
+  const int vpc = mesh.VerticesPerCell();
+  for (std::int64_t e = 0; e < mesh.NumberOfElements(); ++e)
+  {
+    if (label[e])
+    {
+      const std::int64_t* c = mesh.Cell(e);
+      const V3 a = Sub(frame[c[1]], frame[c[0]]), d = Sub(frame[c[2]], frame[c[0]]);
+      sum += vpc == 3 ? std::fabs(a[0] * d[1] - a[1] * d[0]) / 2.0 : std::fabs(Dot(a, Cross(d, Sub(frame[c[3]], frame[c[0]])))) / 6.0;
+    }
+  }
+  return sum;
 }
 
 // Enclosed measure of the boundary (frame coordinates): the divergence theorem over its faces.
@@ -353,10 +471,6 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
   {
     r.Error = "there must be one label per element.";
   }
-  if (r.Error.empty() && std::any_of(label.begin(), label.end(), [](std::uint8_t l) { return l > 1; }))
-  {
-    r.Error = "the labels must be 0 (background) or 1 (object), as the Super-Voxel Cut writes them.";
-  }
   if (!r.Error.empty())
   {
     return r;
@@ -367,7 +481,13 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
   r.Points = mesh.Points();
   r.Faces = LabelBoundaryFaces(mesh, label, &r.InterfaceFaces);
   std::vector<V3> frame = mesh.FramePoints();
-  r.ObjectMeasureBefore = EnclosedMeasure(frame, r.Faces, faceSize);
+  // Several labels: interfaces between objects are inside the labelled region, so its measure is
+  // summed over elements rather than enclosed by the boundary.
+  const bool several = std::any_of(label.begin(), label.end(), [](std::uint8_t l) { return l > 1; });
+  auto measure = [&](const std::vector<V3>& points) {
+    return several ? LabelledMeasure(mesh, points, label) : EnclosedMeasure(points, r.Faces, faceSize);
+  };
+  r.ObjectMeasureBefore = measure(frame);
   r.Shortfall.assign(frame.size(), 0.0);
   if (r.Faces.empty())
   {
@@ -389,12 +509,20 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
   // object's faces on the box would pull the rim inwards (a free-boundary condition instead).
   const std::uint8_t allAxes = faceSize == 2 ? 3 : 7;
   std::vector<const CompressedRows*> rows(n, &b.Neighbours);
+  const Junctions junctions = several ? JunctionGraph(mesh, label, b, r.InterfaceFaces) : Junctions();
   for (std::int64_t i = 0; i < n; ++i)
   {
-    axes[i] = b.Pinched[i] ? 0 : freeAxes[b.Node[i]];
-    r.PinchedNodes += b.Pinched[i];
+    // A junction curve's node is not a manifold point of one surface; it moves along the curve.
+    const bool curve = several && junctions.OnCurve[i];
+    const bool pinched = several ? (junctions.Fixed[i] || (!curve && b.Pinched[i])) : b.Pinched[i];
+    axes[i] = pinched ? 0 : freeAxes[b.Node[i]];
+    r.PinchedNodes += pinched;
     x[i] = frame[b.Node[i]];
-    if (axes[i] && axes[i] != allAxes && b.InterfaceNeighbours.Size(i) > 0)
+    if (curve)
+    {
+      rows[i] = &junctions.Curve;
+    }
+    else if (axes[i] && axes[i] != allAxes && b.InterfaceNeighbours.Size(i) > 0)
     {
       rows[i] = &b.InterfaceNeighbours;
     }
@@ -444,7 +572,7 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
       r.BoundaryPoints[b.Node[i]] = toIndex(b.Node[i], x[i]);
       smoothed[b.Node[i]] = x[i];
     }
-    r.ObjectMeasureAfter = EnclosedMeasure(smoothed, r.Faces, faceSize);
+    r.ObjectMeasureAfter = several ? r.ObjectMeasureBefore : EnclosedMeasure(smoothed, r.Faces, faceSize);
     return r;
   }
 
@@ -649,7 +777,7 @@ SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const 
   }
   r.ReachedFraction = total > 0 ? 1.0 - missed / total : 1.0;
   r.BoundaryPoints = r.Points;
-  r.ObjectMeasureAfter = EnclosedMeasure(frame, r.Faces, faceSize);
+  r.ObjectMeasureAfter = measure(frame);
   r.VolumeSeconds = Seconds(start);
   return r;
 }

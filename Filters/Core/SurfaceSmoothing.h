@@ -10,7 +10,8 @@
 // a node averages its interface neighbours only (the object's faces on the box would pull the rim
 // inwards). A node where the boundary is not
 // a manifold (3D: an edge of more or fewer than two faces, or a vertex whose faces form several
-// fans; 2D: a vertex of other than two edges) is a pinch between two parts of the object and stays.
+// fans; 2D: a vertex of other than two edges) is a pinch between two parts of the object and stays
+// (with several labels: unless it lies on a junction curve, see SmoothSegmentationSurface).
 //
 // The labelled mesh then follows: every boundary node moves towards its smoothed position in
 // steps, the nodes within `RelaxationRings` of the boundary carry a share of the move that fades
@@ -82,8 +83,12 @@ struct SurfaceSmoothingResult
   std::string Error;
 };
 
-// Smooths the boundary between label 1 and label 0 of `mesh` (one label per element, 0 or 1) and,
-// with VolumeMesh, moves the mesh with it.
+// Smooths the boundary between the labels of `mesh` (one label per element, 0 background, 1..255
+// objects) and, with VolumeMesh, moves the mesh with it. With several object labels every interface
+// between two labels is smoothed; where three labels meet (a junction curve) a node moves along the
+// curve only (the mean of its two curve neighbours), and where more meet, or a curve ends or
+// branches (a junction point), it stays: the vertex classification of vtkWindowedSincPolyDataFilter's
+// feature edges. ObjectMeasure is then the elements' measure summed over labels 1..k.
 SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const std::vector<std::uint8_t>& label,
   const SurfaceSmoothingParameters& parameters, const ParallelFor& parallel,
   const ProgressFunction& progress = NoProgress());

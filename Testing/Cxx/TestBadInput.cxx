@@ -1446,9 +1446,9 @@ TEST(SegmentationSurfaceSmoothing, MeshWithoutLabel)
     EXPECT_EQ(m->GetNumberOfCells(), 0);
   });
 }
-TEST(SegmentationSurfaceSmoothing, LabelTwoAndNaN)
+TEST(SegmentationSurfaceSmoothing, LabelsNaNNegativeFractionalOrBeyond255)
 {
-  for (const double bad : { 2.0, NaN, -1.0 })
+  for (const double bad : { 256.0, NaN, -1.0, 1.5 })
   {
     auto labelled = LabelledMeshOf(Disc());
     vtkNew<vtkDoubleArray> label;

@@ -170,7 +170,10 @@ frameless = ft.fm.ps.ProgrammableFilter(Input=ft.fm.ps.OutputPort(cut, 0), Outpu
                                         Script="output.ShallowCopy(inputs[0].VTKObject)\noutput.GetFieldData().Initialize()")
 ft.check(cells_of(LabelledMesh=frameless) == 0, "a mesh without its image frame: error")
 scaled = ft.fm.ps.Calculator(Input=ft.fm.ps.OutputPort(cut, 0), AttributeType="Cell Data", ResultArrayName="Label",
-                             Function="Label*2", ResultArrayType="Unsigned Char")
-ft.check(cells_of(LabelledMesh=scaled) == 0, "labels other than 0 and 1: error")
+                             Function="Label*2.5", ResultArrayType="Double")
+ft.check(cells_of(LabelledMesh=scaled) == 0, "fractional labels: error")
+negative = ft.fm.ps.Calculator(Input=ft.fm.ps.OutputPort(cut, 0), AttributeType="Cell Data", ResultArrayName="Label",
+                               Function="Label-1", ResultArrayType="Double")
+ft.check(cells_of(LabelledMesh=negative) == 0, "negative labels: error")
 print("all surface smoothing checks passed")
 ft.finish()

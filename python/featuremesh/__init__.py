@@ -22,7 +22,7 @@ DATA = os.environ.get("FEATUREMESH_DATA", os.path.join(ROOT, "Data"))
 SHARED = os.environ.get("FEATUREMESH_SHARED_DATA", os.path.join(os.path.dirname(ROOT), "shared", "data"))
 
 __all__ = ["ROOT", "DATA", "SHARED", "np", "v2n", "find_plugin", "load_plugin", "cases", "case_dir", "seeds", "fetch",
-           "labels", "dice", "case_task", "Case", "multilabel_cases", "MultiLabelCase"]
+           "labels", "dice", "case_task", "Case", "multilabel_cases", "MultiLabelCase", "label_names_from_csv"]
 
 
 def find_plugin():
@@ -176,6 +176,13 @@ def multilabel_cases(selection=()):
     return {k: v for k, v in found.items() if not selection or k in selection}
 
 
+def label_names_from_csv(path):
+    """[name of label 0, 1, .., k] from a CSV with columns label,name (label 0 is "background" unless listed)."""
+    with open(path, newline="") as f:
+        rows = {int(r["label"]): r["name"] for r in csv.DictReader(f)}
+    return [rows.get(k, "background" if k == 0 else "label_%d" % k) for k in range(max(rows) + 1)]
+
+
 class MultiLabelCase:
     """A multi-label case folder (image.mha of one or more channels, seeds.csv with x,y,z,label,
     labels.csv, optional truth.mha). Stages 1-3 run on the first channel; the cuts get every
@@ -195,9 +202,7 @@ class MultiLabelCase:
         else:
             self.first, self.first_scalars = self.image, ["POINTS", self.array]
         self.seeds = ps.CSVReader(FileName=[seeds_file or os.path.join(folder, "seeds.csv")])
-        self.names = ["background"]
-        with open(os.path.join(folder, "labels.csv"), newline="") as f:
-            self.names += [row["name"] for row in sorted(csv.DictReader(f), key=lambda r: int(r["label"]))]
+        self.names = label_names_from_csv(os.path.join(folder, "labels.csv"))
 
     def truth(self):
         path = os.path.join(self.folder, "truth.mha")

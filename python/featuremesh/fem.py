@@ -2,11 +2,14 @@
 output 0) through meshio: Gmsh, Medit, Abaqus and Exodus II, with one tag table for all of them.
 
 Tags (the one source of truth; README "FEM export" lists them):
-- regions: label L is Gmsh physical group L + 1 (Gmsh reserves 0) named REGION_NAMES[L]; Medit ref L
-  on the elements; Abaqus element set and Exodus element block REGION_NAMES[L].
-- boundary faces (triangles in 3D, edges in 2D): the interface between labels is INTERFACE_TAG, the
-  image box's sides BOX_TAG0 + side (xmin, xmax, ymin, ymax[, zmin, zmax]); Gmsh physical groups and
-  Medit refs on the faces, Abaqus and Exodus node sets of the same names.
+- regions: label L is Gmsh physical group L + 1 (Gmsh reserves 0) named after the label (the grid's
+  LabelNames field data, else REGION_NAMES, else label_L); Medit ref L on the elements; Abaqus element
+  set and Exodus element block of the same name.
+- boundary faces (triangles in 3D, edges in 2D): with labels 0 and 1 only, the interface is
+  INTERFACE_TAG; with several object labels, each pair of touching labels a < b is PAIR_TAG0 + 256 a + b
+  named "name_a|name_b" (Abaqus: "name_a__name_b", as its set names take letters, digits and
+  underscores). The image box's sides are BOX_TAG0 + side (xmin, xmax, ymin, ymax[, zmin, zmax]).
+  Gmsh physical groups and Medit refs on the faces, Abaqus and Exodus node sets of the same names.
 """
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -18,6 +21,7 @@ INTERFACE_TAG = 10
 INTERFACE_NAME = "interface"
 BOX_TAG0 = 11
 BOX_SIDES = ["box_xmin", "box_xmax", "box_ymin", "box_ymax", "box_zmin", "box_zmax"]
+PAIR_TAG0 = 1000
 FORMATS = {"gmsh": ".msh", "medit": ".mesh", "abaqus": ".inp", "exodus": ".exo"}
 
 
@@ -55,9 +59,28 @@ def _outward(points, cells, owner, f, ids):
     return ids
 
 
+def label_names(grid, labels):
+    """{label: name} for the labels present: the grid's LabelNames field data where it names them,
+    else REGION_NAMES, else label_L."""
+    given = grid.GetFieldData().GetAbstractArray("LabelNames") if grid.GetFieldData() else None
+    binary = labels.max(initial=0) <= 1
+    names = {}
+    for L in (int(x) for x in np.unique(labels)):
+        name = given.GetValue(L) if given is not None and L < given.GetNumberOfValues() else ""
+        names[L] = name or (REGION_NAMES[L] if binary or L == 0 else "label_%d" % L)
+    return names
+
+
+def pair_tag(a, b):
+    """The boundary tag of the interface between labels a and b (several object labels)."""
+    a, b = min(a, b), max(a, b)
+    return PAIR_TAG0 + 256 * a + b
+
+
 def boundary_faces(points, cells, labels, tolerance=1e-9):
     """Tagged boundary faces: (faces (k, vpc - 1), tags (k,)). Interface faces (two cells of different
-    labels) point out of the higher label; box faces (one cell) out of the box, tagged by side."""
+    labels) point out of the higher label, tagged INTERFACE_TAG with labels 0 and 1 only, else by their
+    pair (pair_tag); box faces (one cell) out of the box, tagged by side."""
     owner, f, ids, key = _faces(cells)
     _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
     inverse = inverse.ravel()
@@ -76,7 +99,10 @@ def boundary_faces(points, cells, labels, tolerance=1e-9):
     dim = cells.shape[1] - 1
     lo, hi = points[:, :dim].min(0), points[:, :dim].max(0)
     tags = np.full(len(owner), -1)
-    tags[interface] = INTERFACE_TAG
+    if labels.max(initial=0) <= 1:
+        tags[interface] = INTERFACE_TAG
+    else:
+        tags[interface] = PAIR_TAG0 + 256 * low[inverse[interface]] + pair_label[inverse[interface]]
     P = points[ids[hull]]
     hull_tags = np.full(hull.sum(), -1)
     for axis in range(dim):
@@ -111,9 +137,14 @@ def element_measures(points, cells):
     return np.einsum("ij,ij->i", P[:, 1] - P[:, 0], np.cross(P[:, 2] - P[:, 0], P[:, 3] - P[:, 0])) / 6.0
 
 
-def tag_names(dim):
+def tag_names(dim, regions=None):
+    """{tag: name} of the boundary tags; `regions` ({label: name}) names the pair tags."""
     names = {INTERFACE_TAG: INTERFACE_NAME}
     names.update({BOX_TAG0 + s: BOX_SIDES[s] for s in range(2 * dim)})
+    for a in regions or {}:
+        for b in regions or {}:
+            if a < b:
+                names[pair_tag(a, b)] = "%s|%s" % (regions[a], regions[b])
     return names
 
 
@@ -125,17 +156,18 @@ def write(grid, base, unit="mm", formats=tuple(FORMATS)):
     dim = vpc - 1
     volume_type, face_type = ("tetra", "triangle") if vpc == 4 else ("triangle", "line")
     faces, tags = boundary_faces(points, cells, labels)
-    present = [L for L in sorted(REGION_NAMES) if (labels == L).any()]
+    region = label_names(grid, labels)
+    present = sorted(region)
     blocks = [(volume_type, cells[labels == L]) for L in present]
     face_tags = sorted(set(tags.tolist()))
     face_blocks = [(face_type, faces[tags == t]) for t in face_tags]
-    names = tag_names(dim)
+    names = tag_names(dim, region)
     nodes = {names[t]: np.unique(faces[tags == t]) for t in face_tags}
     written = {}
     for fmt in formats:
         path = base + FORMATS[fmt]
         if fmt == "gmsh":
-            field = {REGION_NAMES[L]: np.array([L + 1, dim]) for L in present}
+            field = {region[L]: np.array([L + 1, dim]) for L in present}
             field.update({names[t]: np.array([t, dim - 1]) for t in face_tags})
             physical = [np.full(len(c), L + 1) for L, (_, c) in zip(present, blocks)] + \
                        [np.full(len(c), t) for t, (_, c) in zip(face_tags, face_blocks)]
@@ -148,13 +180,14 @@ def write(grid, base, unit="mm", formats=tuple(FORMATS)):
                    [np.full(len(c), t) for t, (_, c) in zip(face_tags, face_blocks)]
             meshio.write(path, meshio.Mesh(points, blocks + face_blocks, cell_data={"medit:ref": refs}), file_format="medit")
         elif fmt == "abaqus":
-            sets = {REGION_NAMES[L]: [np.arange(len(c)) if k == i else np.array([], int) for k in range(len(blocks))]
+            sets = {region[L]: [np.arange(len(c)) if k == i else np.array([], int) for k in range(len(blocks))]
                     for i, (L, (_, c)) in enumerate(zip(present, blocks))}
-            meshio.write(path, meshio.Mesh(points, blocks, cell_sets=sets, point_sets=nodes), file_format="abaqus")
+            abaqus_nodes = {name.replace("|", "__"): ids for name, ids in nodes.items()}
+            meshio.write(path, meshio.Mesh(points, blocks, cell_sets=sets, point_sets=abaqus_nodes), file_format="abaqus")
         elif fmt == "exodus":
             meshio.write(path, meshio.Mesh(points, blocks, point_sets=nodes), file_format="exodus")
             _exodus_info(path, ["FeatureMesh labelled mesh", "length unit: %s" % unit] +
-                         ["element block %d: %s" % (i + 1, REGION_NAMES[L]) for i, L in enumerate(present)])
+                         ["element block %d: %s" % (i + 1, region[L]) for i, L in enumerate(present)])
         written[fmt] = path
     return written
 
@@ -181,6 +214,7 @@ def report(grid, bins=np.arange(0, 181, 5)):
     (smallest angle in 2D, smallest dihedral angle in 3D, degrees) of each label's elements."""
     from . import metrics
     points, cells, labels = grid_arrays(grid)
+    region = label_names(grid, labels)
     measures = np.abs(element_measures(points, cells))
     components = components_per_label(cells, labels)
     quality = metrics.element_angles(points, cells).min(axis=1)
@@ -188,7 +222,7 @@ def report(grid, bins=np.arange(0, 181, 5)):
     for L in np.unique(labels):
         sel = labels == L
         hist, _ = np.histogram(quality[sel], bins)
-        out[REGION_NAMES.get(int(L), str(int(L)))] = {
+        out[region[int(L)]] = {
             "elements": int(sel.sum()), "measure": float(measures[sel].sum()), "components": components[int(L)],
             "min_quality_degrees": float(quality[sel].min()), "quality_histogram": hist.tolist()}
     return {"labels": out, "histogram_bins_degrees": bins.tolist()}
