@@ -11,3 +11,7 @@ for c in nuclei-dsb2018:class liver-ct-totalseg:object; do
     --object-seeds "Data/$c/seeds_object.csv" --background-seeds "Data/$c/seeds_background.csv" \
     --truth "Data/$c/truth.mha" --out out
 done
+# Several labels: five organs of the abdomen CT from one CSV of labelled seeds (x,y,z,label).
+c=Data/multilabel/abdomen-ct-totalseg
+xvfb-run -a pvpython scripts/featuremesh_segment.py "$c/image.mha" --seeds "$c/seeds.csv" --labels "$c/labels.csv" \
+  --truth "$c/truth.mha" --out out

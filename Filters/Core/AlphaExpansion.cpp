@@ -112,7 +112,7 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
       label[p] = static_cast<std::uint8_t>(hard(p) >= 0 ? hard(p) : 0);
     }
   }
-  // K exceeds the energy of any labelling: a hard node never leaves its label.
+  // The energy of any labelling stays below K: finite costs and weights whose sum overflows are an error.
   double K = 1.0;
   for (std::int64_t p = 0; p < n; ++p)
   {
@@ -131,93 +131,143 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
   const GraphEdges& edges = *pr.Edges;
   const std::int64_t m = edges.Size();
   double energy = PottsEnergy(pr, label);
+  // Each node's summed boundary weight: the most a move's pairwise terms can reward it for switching.
+  std::vector<double> reach(n, 0.0);
+  // And its neighbours with the edges' weights (compressed rows), to price a move by the nodes it moved.
+  std::vector<std::int64_t> first(n + 1, 0);
+  edges.ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
+    reach[p] += pr.Weight[k];
+    reach[q] += pr.Weight[k];
+    ++first[p + 1];
+    ++first[q + 1];
+  });
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    first[p + 1] += first[p];
+  }
+  std::vector<std::int64_t> neighbour(first[n]);
+  std::vector<double> weight(first[n]);
+  {
+    std::vector<std::int64_t> at(first.begin(), first.end() - 1);
+    edges.ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
+      neighbour[at[p]] = q;
+      weight[at[p]++] = pr.Weight[k];
+      neighbour[at[q]] = p;
+      weight[at[q]++] = pr.Weight[k];
+    });
+  }
   std::vector<double> keep(n), take(n);
+  std::vector<std::int32_t> id(n); // a node's id in the move's graph, -1 when it is fixed
   try
   {
     Flow g(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory);
     const int total = std::max(1, maxCycles) * L;
-    for (r.Cycles = 0; r.Cycles < std::max(1, maxCycles);)
+    // Done when every label's move has been tried since the last move that lowered the energy.
+    int sinceLowered = 0;
+    for (r.Cycles = 0; r.Cycles < std::max(1, maxCycles) && sinceLowered < L;)
     {
       ++r.Cycles;
-      bool lowered = false;
-      for (int alpha = 0; alpha < L; ++alpha)
+      for (int alpha = 0; alpha < L && sinceLowered < L; ++alpha, ++sinceLowered)
       {
         if (!progress(static_cast<double>((r.Cycles - 1) * L + alpha) / total))
         {
           r.Aborted = true;
           return r;
         }
-        // Node p in the source segment keeps its label and pays keep[p]; in the sink it takes alpha
-        // and pays take[p]. Nodes already at alpha are fixed and left out of the graph's edges.
+        // Node p keeps its label and pays keep[p] (source segment), or takes alpha and pays take[p]
+        // (sink). Fixed, and left out of the graph: nodes at alpha, hard nodes of another label, and
+        // nodes whose cost of alpha exceeds their cost of keeping by at least their summed boundary
+        // weight (no neighbours can make switching pay, so keeping is optimal: the move stays exact).
+        std::int32_t active = 0;
         for (std::int64_t p = 0; p < n; ++p)
         {
           const double* c = &pr.Cost[p * L];
-          if (label[p] == alpha)
-          {
-            keep[p] = take[p] = 0.0;
-          }
-          else
+          keep[p] = take[p] = 0.0;
+          id[p] = -1;
+          if (label[p] != alpha && hard(p) < 0 && c[alpha] - c[label[p]] < reach[p])
           {
             keep[p] = c[label[p]];
-            take[p] = hard(p) >= 0 ? K : c[alpha];
+            take[p] = c[alpha];
+            id[p] = active++;
           }
         }
+        if (active == 0)
+        {
+          continue;
+        }
         g.reset();
-        g.add_node(static_cast<int>(n));
+        g.add_node(active);
         edges.ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
           const double w = pr.Weight[k];
           const int a = label[p], b = label[q];
-          if (w == 0.0 || (a == alpha && b == alpha))
+          if (w == 0.0 || (id[p] < 0 && id[q] < 0))
           {
             return;
           }
-          if (a == alpha)
+          if (id[p] < 0 || id[q] < 0)
           {
-            keep[q] += w;
-          }
-          else if (b == alpha)
-          {
-            keep[p] += w;
+            // One end fixed at its label f: the other pays w when its choice differs from f.
+            const std::int64_t x = id[p] < 0 ? q : p;
+            const int f = id[p] < 0 ? a : b;
+            const int own = id[p] < 0 ? b : a;
+            keep[x] += own != f ? w : 0.0;
+            take[x] += alpha != f ? w : 0.0;
           }
           else if (a == b)
           {
-            g.add_edge(static_cast<int>(p), static_cast<int>(q), w, w);
+            g.add_edge(id[p], id[q], w, w);
           }
           else
           {
             // Keep/keep pays w (a != b), keep/alpha w, alpha/keep w, alpha/alpha 0.
             keep[q] += w;
-            g.add_edge(static_cast<int>(p), static_cast<int>(q), w, 0.0);
+            g.add_edge(id[p], id[q], w, 0.0);
           }
         });
         for (std::int64_t p = 0; p < n; ++p)
         {
-          if (keep[p] != 0.0 || take[p] != 0.0)
+          if (id[p] >= 0)
           {
-            g.add_tweights(static_cast<int>(p), take[p], keep[p]);
+            const double low = std::min(keep[p], take[p]);
+            g.add_tweights(id[p], take[p] - low, keep[p] - low);
           }
         }
         g.maxflow();
-        std::vector<std::uint8_t> moved(label);
+        std::vector<std::int64_t> switched;
         for (std::int64_t p = 0; p < n; ++p)
         {
-          if (label[p] != alpha && g.what_segment(static_cast<int>(p)) == Flow::SINK)
+          if (id[p] >= 0 && g.what_segment(id[p]) == Flow::SINK)
           {
-            moved[p] = static_cast<std::uint8_t>(alpha);
+            switched.push_back(p);
           }
         }
-        const double e = PottsEnergy(pr, moved);
-        if (e < energy - 1e-9 * std::max(1.0, std::fabs(energy)))
+        // The move's energy change, from the nodes it switched and their edges (an edge between two
+        // switched nodes counted once).
+        double change = 0.0;
+        for (const std::int64_t p : switched)
         {
-          label.swap(moved);
-          energy = e;
-          ++r.Moves;
-          lowered = true;
+          change += pr.Cost[p * L + alpha] - pr.Cost[p * L + label[p]];
+          for (std::int64_t j = first[p]; j < first[p + 1]; ++j)
+          {
+            const std::int64_t q = neighbour[j];
+            const bool both = id[q] >= 0 && g.what_segment(id[q]) == Flow::SINK;
+            if (both && q < p)
+            {
+              continue;
+            }
+            change += weight[j] * ((both ? 0 : alpha != label[q]) - (label[p] != label[q] ? 1.0 : 0.0));
+          }
         }
-      }
-      if (!lowered)
-      {
-        break;
+        if (change < -1e-9 * std::max(1.0, std::fabs(energy)))
+        {
+          for (const std::int64_t p : switched)
+          {
+            label[p] = static_cast<std::uint8_t>(alpha);
+          }
+          energy += change;
+          ++r.Moves;
+          sinceLowered = 0;
+        }
       }
     }
   }
@@ -226,8 +276,8 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
     r.Error = "not enough memory for the max-flow graph (" + std::to_string(n) + " nodes, " + std::to_string(m) + " edges).";
     return r;
   }
+  r.Energy = PottsEnergy(pr, label); // summed afresh: the moves' changes carry rounding
   r.Label = std::move(label);
-  r.Energy = energy;
   return r;
 }
 } // namespace featuremesh

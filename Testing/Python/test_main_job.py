@@ -119,4 +119,18 @@ def check_fem(base, is3d):
 
 check_fem(os.path.join(out, "nuclei-dsb2018"), False)
 check_fem(os.path.join(out, "liver-ct-totalseg"), True)
+
+# Labelled seeds: the abdomen's five organs from one CSV (x,y,z,label) and their names.
+d = os.path.join(ft.fm.DATA, "multilabel", "abdomen-ct-totalseg")
+run = subprocess.run([shutil.which("pvpython"), script, os.path.join(d, "image.mha"), "--seeds", os.path.join(d, "seeds.csv"),
+                      "--labels", os.path.join(d, "labels.csv"), "--truth", os.path.join(d, "truth.mha"), "--out", out],
+                     capture_output=True, text=True)
+ft.check(run.returncode == 0, "--seeds: the script exits 0 (stderr: %s)" % run.stderr[-800:])
+base = os.path.join(out, "abdomen-ct-totalseg")
+report = json.load(open(base + "_report.json")) if os.path.isfile(base + "_report.json") else {}
+names = ["liver", "spleen", "kidney_right", "kidney_left", "stomach"]
+ft.check(list(report.get("dice_per_label", {})) == names and report.get("labels") == 6,
+         "--seeds: Dice per named label (%s)" % report.get("dice_per_label"))
+ft.check(list(report.get("fem", {}).get("labels", {})) == ["background"] + names, "--seeds: the FEM report per named label")
+ft.check(all(os.path.isfile(base + "_fem" + s) for s in (".msh", ".mesh", ".inp", ".exo")), "--seeds: the four FEM files")
 print("all main-job checks passed")
