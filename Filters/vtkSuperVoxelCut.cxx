@@ -145,7 +145,6 @@ int vtkSuperVoxelCut::RequestData(
     vtkImageData* image = vtkImageData::GetData(inputVector[3], 0);
     vtkDataObject* labelledSeeds = vtkDataObject::GetData(inputVector[4], 0);
     vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
-    vtkPolyData* boundary = vtkPolyData::GetData(outputVector, 1);
     vtkImageData* labelImage = vtkImageData::GetData(outputVector, 2);
     std::string error, warning;
     auto fail = [&](const std::string& why) {
@@ -308,7 +307,6 @@ int vtkSuperVoxelCut::RequestData(
     {
       return fail(error);
     }
-    const vtkIdType nCells = input->GetNumberOfCells();
     this->UpdateProgress(0.45);
     const ParallelFor parallel = SMPParallelFor();
     VoxelValueFunction voxelValue;
@@ -329,34 +327,7 @@ int vtkSuperVoxelCut::RequestData(
     this->UpdateProgress(0.7);
     const CutResult& cut = result.Cut;
 
-    // Output 0: the mesh with labels.
-    output->ShallowCopy(input);
-    DropVoxelOwners(output);
-    vtkNew<vtkUnsignedCharArray> label;
-    label->SetName(names::Label);
-    label->SetNumberOfTuples(nCells);
-    std::copy(cut.Label.begin(), cut.Label.end(), label->GetPointer(0));
-    output->GetCellData()->AddArray(label);
-    output->GetCellData()->SetActiveScalars(names::Label);
-
-    // Output 1: the boundary, on the mesh's points (2D polylines, 3D a closed outward surface).
-    BoundaryPolyData(input->GetPoints(), result.BoundaryFaces, mesh.VerticesPerCell() - 1, boundary);
-
-    // Output 2: the labels on the image grid.
-    SetImageFrame(labelImage, geometry);
-    vtkNew<vtkUnsignedCharArray> voxels;
-    voxels->SetName(names::Label);
-    voxels->SetNumberOfTuples(geometry.Size());
-    VoxelLabels(data.Cut.Owner, cut.Label, voxels->GetPointer(0), parallel);
-    labelImage->GetPointData()->SetScalars(voxels);
-    if (this->SuperVoxelIds)
-    {
-      vtkNew<vtkIdTypeArray> ids;
-      ids->SetName(names::ElementId);
-      ids->SetNumberOfTuples(geometry.Size());
-      std::copy(data.Cut.Owner.begin(), data.Cut.Owner.end(), ids->GetPointer(0));
-      labelImage->GetPointData()->AddArray(ids);
-    }
+    this->WriteLabels(input, cut.Label, result.BoundaryFaces, outputVector);
 
     const auto objectElements = std::count(cut.Label.begin(), cut.Label.end(), LabelObject);
     for (vtkDataObject* d : { static_cast<vtkDataObject*>(output), static_cast<vtkDataObject*>(labelImage) })
@@ -375,6 +346,42 @@ int vtkSuperVoxelCut::RequestData(
     this->UpdateProgress(1.0);
     return 1;
   });
+}
+
+void vtkSuperVoxelCut::WriteLabels(vtkUnstructuredGrid* input, const std::vector<std::uint8_t>& labels,
+  const std::vector<std::int64_t>& boundaryFaces, vtkInformationVector* outputVector)
+{
+  using namespace featuremesh;
+  const MeshData& data = *this->Prepared;
+  const ImageGeometry& geometry = data.Mesh.Geometry();
+  // Output 0: the mesh with labels.
+  vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
+  output->ShallowCopy(input);
+  DropVoxelOwners(output);
+  vtkNew<vtkUnsignedCharArray> label;
+  label->SetName(names::Label);
+  label->SetNumberOfTuples(static_cast<vtkIdType>(labels.size()));
+  std::copy(labels.begin(), labels.end(), label->GetPointer(0));
+  output->GetCellData()->AddArray(label);
+  output->GetCellData()->SetActiveScalars(names::Label);
+  // Output 1: the boundary, on the mesh's points (2D polylines, 3D triangles outward).
+  BoundaryPolyData(input->GetPoints(), boundaryFaces, data.Mesh.VerticesPerCell() - 1, vtkPolyData::GetData(outputVector, 1));
+  // Output 2: the labels on the image grid.
+  vtkImageData* labelImage = vtkImageData::GetData(outputVector, 2);
+  SetImageFrame(labelImage, geometry);
+  vtkNew<vtkUnsignedCharArray> voxels;
+  voxels->SetName(names::Label);
+  voxels->SetNumberOfTuples(geometry.Size());
+  VoxelLabels(data.Cut.Owner, labels, voxels->GetPointer(0), SMPParallelFor());
+  labelImage->GetPointData()->SetScalars(voxels);
+  if (this->SuperVoxelIds)
+  {
+    vtkNew<vtkIdTypeArray> ids;
+    ids->SetName(names::ElementId);
+    ids->SetNumberOfTuples(geometry.Size());
+    std::copy(data.Cut.Owner.begin(), data.Cut.Owner.end(), ids->GetPointer(0));
+    labelImage->GetPointData()->AddArray(ids);
+  }
 }
 
 int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featuremesh::LabelledSeeds& seeds,
@@ -432,32 +439,9 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
     vtkErrorMacro("Super-Voxel Cut: " << result.Error);
     return 0;
   }
+  this->WriteLabels(input, result.Label, result.BoundaryFaces, outputVector);
   vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
-  vtkPolyData* boundary = vtkPolyData::GetData(outputVector, 1);
   vtkImageData* labelImage = vtkImageData::GetData(outputVector, 2);
-  output->ShallowCopy(input);
-  DropVoxelOwners(output);
-  vtkNew<vtkUnsignedCharArray> label;
-  label->SetName(names::Label);
-  label->SetNumberOfTuples(mesh.NumberOfElements());
-  std::copy(result.Label.begin(), result.Label.end(), label->GetPointer(0));
-  output->GetCellData()->AddArray(label);
-  output->GetCellData()->SetActiveScalars(names::Label);
-  BoundaryPolyData(input->GetPoints(), result.BoundaryFaces, mesh.VerticesPerCell() - 1, boundary);
-  SetImageFrame(labelImage, geometry);
-  vtkNew<vtkUnsignedCharArray> voxels;
-  voxels->SetName(names::Label);
-  voxels->SetNumberOfTuples(geometry.Size());
-  VoxelLabels(data.Cut.Owner, result.Label, voxels->GetPointer(0), parallel);
-  labelImage->GetPointData()->SetScalars(voxels);
-  if (this->SuperVoxelIds)
-  {
-    vtkNew<vtkIdTypeArray> ids;
-    ids->SetName(names::ElementId);
-    ids->SetNumberOfTuples(geometry.Size());
-    std::copy(data.Cut.Owner.begin(), data.Cut.Owner.end(), ids->GetPointer(0));
-    labelImage->GetPointData()->AddArray(ids);
-  }
   for (vtkDataObject* d : { static_cast<vtkDataObject*>(output), static_cast<vtkDataObject*>(labelImage) })
   {
     AddLabelTable(d, result.Labels, this->LabelNames);

@@ -20,8 +20,10 @@
 #include "FeatureMeshFiltersModule.h"
 #include "vtkUnstructuredGridAlgorithm.h"
 
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 class vtkDataArray;
 class vtkUnstructuredGrid;
@@ -126,6 +128,9 @@ protected:
   std::string LabelNames;
 
 private:
+  // The three outputs from the elements' labels and the boundary faces between them.
+  void WriteLabels(vtkUnstructuredGrid* input, const std::vector<std::uint8_t>& labels,
+    const std::vector<std::int64_t>& boundaryFaces, vtkInformationVector* outputVector);
   // The cut with labelled seeds on the Seeds input.
   int RequestMultiLabel(vtkUnstructuredGrid* input, const featuremesh::LabelledSeeds& seeds, vtkDataArray* values,
     const featuremesh::SuperVoxelCutParameters& parameters, vtkInformationVector* outputVector);

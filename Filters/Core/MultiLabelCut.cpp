@@ -246,23 +246,9 @@ bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, 
 void SeedBallSamples(const LabelledSeeds& seeds, const ChannelBins& bins, const ImageGeometry& g, double radius,
   std::vector<std::vector<double>>& samples)
 {
-  const int rad = static_cast<int>(std::floor(radius));
-  const int rk = g.Is2D() ? 0 : rad;
   for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
   {
-    const std::int64_t v = seeds.Voxel[s];
-    const int k = static_cast<int>(v / g.SliceStride());
-    const int j = static_cast<int>((v % g.SliceStride()) / g.Dims[0]);
-    const int i = static_cast<int>(v % g.Dims[0]);
-    for (int dk = -rk; dk <= rk; ++dk)
-      for (int dj = -rad; dj <= rad; ++dj)
-        for (int di = -rad; di <= rad; ++di)
-        {
-          if (di * di + dj * dj + dk * dk <= radius * radius && g.Contains(i + di, j + dj, k + dk))
-          {
-            samples[seeds.Label[s]][bins.Bin[g.Index(i + di, j + dj, k + dk)]] += 1.0;
-          }
-        }
+    ForEachVoxelWithin(g, seeds.Voxel[s], radius, [&](std::int64_t v) { samples[seeds.Label[s]][bins.Bin[v]] += 1.0; });
   }
 }
 
@@ -280,6 +266,64 @@ std::string CheckSeeds(const LabelledSeeds& seeds)
 {
   std::vector<double> labels(seeds.Label.begin(), seeds.Label.end());
   return ValidateSeedLabels(labels);
+}
+
+// The checks both cuts make first: the seeds' labels, the inputs' sizes, the parameters.
+std::string CheckInputs(const LabelledSeeds& seeds, bool sizesMatch, const char* mismatch, const SeededCutParameters& par)
+{
+  std::string error = CheckSeeds(seeds);
+  if (error.empty() && !sizesMatch)
+  {
+    error = mismatch;
+  }
+  return error.empty() ? ValidateParameters(par) : error;
+}
+
+// What both cuts do once their graph, region costs and hard labels are made: the seeds' geodesic
+// term (Task Object), the Potts weights, alpha-expansion from `start` and the connectivity rule.
+// `mean` holds the nodes' channel vectors, `size` their voxel counts (empty: 1 each), `step` the
+// explicit edges' lengths (null: the grid), `contact` their contacts (empty: 1 each).
+void SolveLabels(PottsProblem& pr, std::vector<std::int16_t> hard, const std::vector<double>& mean, const ChannelBins& bins,
+  const std::vector<double>* step, const std::vector<double>& contact, const std::vector<double>& size,
+  const std::vector<std::uint8_t>& border, const SeededCutParameters& par, const MultiLabelParameters& multi,
+  std::vector<std::uint8_t> start, const ProgressFunction& progress, MultiLabelCache* cache, Clock::time_point t0,
+  MultiLabelResult& r)
+{
+  const GraphEdges& edges = *pr.Edges;
+  if (par.Task == Task::Object && par.Geodesic.Weight > 0.0)
+  {
+    const auto g0 = Clock::now();
+    if (!AddGeodesicCosts(edges, mean, bins, step, hard, pr.Labels, par.Geodesic, par.Lambda, size, pr.Cost,
+          SubProgress(progress, 0.0, 0.2), cache))
+    {
+      r.Aborted = true;
+      return;
+    }
+    r.GeodesicSeconds = Since(g0);
+  }
+  r.Sigma = par.Sigma;
+  pr.Weight = PottsWeights(edges, mean, bins.Channels, contact, r.Sigma);
+  pr.Hard = hard;
+  r.SetupSeconds = Since(t0);
+  const auto t1 = Clock::now();
+  ExpansionResult x = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.2, 0.95), multi.MaxCycles);
+  r.ExpansionSeconds = Since(t1);
+  if (!x.Error.empty() || x.Aborted)
+  {
+    r.Error = x.Error;
+    r.Aborted = x.Aborted;
+    return;
+  }
+  if (cache)
+  {
+    cache->Label = x.Label;
+  }
+  r.Energy = x.Energy;
+  r.Moves = x.Moves;
+  r.Cycles = x.Cycles;
+  r.Label = std::move(x.Label);
+  r.ConnectivityChanged =
+    ApplyLabelConnectivity(ConnectivityFor(par.Connectivity, par.Task), r.Label, edges, pr.Weight, hard, border);
 }
 } // namespace
 
@@ -604,18 +648,10 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
   const auto t0 = Clock::now();
   MultiLabelResult r;
   const std::int64_t n = mesh.NumberOfElements();
-  r.Error = CheckSeeds(seeds);
-  if (r.Error.empty() && (static_cast<std::int64_t>(runs.Offset.size()) != n + 1 ||
-                           static_cast<std::int64_t>(mean.size()) != n * bins.Channels ||
-                           static_cast<std::int64_t>(count.size()) != n ||
-                           static_cast<std::int64_t>(data.Owner.size()) != mesh.Geometry().Size()))
-  {
-    r.Error = "the voxel owners or channel statistics do not match the mesh.";
-  }
-  if (r.Error.empty())
-  {
-    r.Error = ValidateParameters(par);
-  }
+  r.Error = CheckInputs(seeds,
+    static_cast<std::int64_t>(runs.Offset.size()) == n + 1 && static_cast<std::int64_t>(mean.size()) == n * bins.Channels &&
+      static_cast<std::int64_t>(count.size()) == n && static_cast<std::int64_t>(data.Owner.size()) == mesh.Geometry().Size(),
+    "the voxel owners or channel statistics do not match the mesh.", par);
   if (!r.Error.empty())
   {
     return r;
@@ -663,23 +699,12 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
       }
     }
   });
-  if (par.Task == Task::Object && par.Geodesic.Weight > 0.0)
+  const std::vector<double> step = data.CentreSteps.size() == faces->A.size() ? data.CentreSteps : CentreDistances(mesh, *faces);
+  std::vector<std::uint8_t> border(n, 0);
+  for (std::int64_t e : faces->HullElement)
   {
-    const auto g0 = Clock::now();
-    const std::vector<double> step = data.CentreSteps.size() == faces->A.size() ? data.CentreSteps : CentreDistances(mesh, *faces);
-    if (!AddGeodesicCosts(edges, mean, bins, &step, hard, L, par.Geodesic, par.Lambda, count, pr.Cost,
-          SubProgress(progress, 0.0, 0.2), cache))
-    {
-      r.Aborted = true;
-      return r;
-    }
-    r.GeodesicSeconds = Since(g0);
+    border[e] = 1;
   }
-  r.Sigma = par.Sigma;
-  pr.Weight = PottsWeights(edges, mean, bins.Channels, ContactInVoxelFaces(mesh, par.ScaleByContact), r.Sigma);
-  pr.Hard = hard;
-  r.SetupSeconds = Since(t0);
-  const auto t1 = Clock::now();
   std::vector<std::uint8_t> start;
   if (cache && static_cast<std::int64_t>(cache->Label.size()) == n)
   {
@@ -689,29 +714,12 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
       l = l < L ? l : 0;
     }
   }
-  ExpansionResult x = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.2, 0.95), multi.MaxCycles);
-  r.ExpansionSeconds = Since(t1);
-  if (!x.Error.empty() || x.Aborted)
+  SolveLabels(pr, hard, mean, bins, &step, ContactInVoxelFaces(mesh, par.ScaleByContact), count, border, par, multi,
+    std::move(start), progress, cache, t0, r);
+  if (!r.Error.empty() || r.Aborted)
   {
-    r.Error = x.Error;
-    r.Aborted = x.Aborted;
     return r;
   }
-  if (cache)
-  {
-    cache->Label = x.Label;
-  }
-  r.Energy = x.Energy;
-  r.Moves = x.Moves;
-  r.Cycles = x.Cycles;
-  r.Label = std::move(x.Label);
-  std::vector<std::uint8_t> border(n, 0);
-  for (std::int64_t e : faces->HullElement)
-  {
-    border[e] = 1;
-  }
-  r.ConnectivityChanged =
-    ApplyLabelConnectivity(ConnectivityFor(par.Connectivity, par.Task), r.Label, edges, pr.Weight, hard, border);
   r.BoundaryFaces = LabelBoundaryFaces(mesh, *faces, r.Label);
   return r;
 }
@@ -723,16 +731,9 @@ MultiLabelResult MultiLabelVoxelCut(const std::vector<double>& values, const Cha
   const auto t0 = Clock::now();
   MultiLabelResult r;
   const std::int64_t n = g.Size();
-  r.Error = CheckSeeds(seeds);
-  if (r.Error.empty() && (static_cast<std::int64_t>(bins.Bin.size()) != n ||
-                           static_cast<std::int64_t>(values.size()) != n * bins.Channels))
-  {
-    r.Error = "the channel values do not match the image.";
-  }
-  if (r.Error.empty())
-  {
-    r.Error = ValidateParameters(par);
-  }
+  r.Error = CheckInputs(seeds,
+    static_cast<std::int64_t>(bins.Bin.size()) == n && static_cast<std::int64_t>(values.size()) == n * bins.Channels,
+    "the channel values do not match the image.", par);
   if (!r.Error.empty())
   {
     return r;
@@ -759,44 +760,7 @@ MultiLabelResult MultiLabelVoxelCut(const std::vector<double>& values, const Cha
       pr.Cost[v * L + l] = par.Lambda * costs[l][bins.Bin[v]];
     }
   }
-  if (par.Task == Task::Object && par.Geodesic.Weight > 0.0)
-  {
-    const auto g0 = Clock::now();
-    if (!AddGeodesicCosts(edges, values, bins, nullptr, hard, L, par.Geodesic, par.Lambda, {}, pr.Cost,
-          SubProgress(progress, 0.0, 0.2), nullptr))
-    {
-      r.Aborted = true;
-      return r;
-    }
-    r.GeodesicSeconds = Since(g0);
-  }
-  r.Sigma = par.Sigma;
-  pr.Weight = PottsWeights(edges, values, bins.Channels, {}, r.Sigma);
-  pr.Hard = hard;
-  r.SetupSeconds = Since(t0);
-  const auto t1 = Clock::now();
-  ExpansionResult x = AlphaExpansion(pr, {}, SubProgress(progress, 0.2, 0.95), multi.MaxCycles);
-  r.ExpansionSeconds = Since(t1);
-  if (!x.Error.empty() || x.Aborted)
-  {
-    r.Error = x.Error;
-    r.Aborted = x.Aborted;
-    return r;
-  }
-  r.Energy = x.Energy;
-  r.Moves = x.Moves;
-  r.Cycles = x.Cycles;
-  r.Label = std::move(x.Label);
-  std::vector<std::uint8_t> border(n, 0);
-  for (int k = 0; k < g.Dims[2]; ++k)
-    for (int j = 0; j < g.Dims[1]; ++j)
-      for (int i = 0; i < g.Dims[0]; ++i)
-      {
-        border[g.Index(i, j, k)] = i == 0 || j == 0 || i + 1 == g.Dims[0] || j + 1 == g.Dims[1] ||
-          (!g.Is2D() && (k == 0 || k + 1 == g.Dims[2]));
-      }
-  r.ConnectivityChanged =
-    ApplyLabelConnectivity(ConnectivityFor(par.Connectivity, par.Task), r.Label, edges, pr.Weight, hard, border);
+  SolveLabels(pr, hard, values, bins, nullptr, {}, {}, BorderVoxels(g), par, multi, {}, progress, nullptr, t0, r);
   return r;
 }
 } // namespace featuremesh

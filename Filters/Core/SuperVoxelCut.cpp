@@ -41,23 +41,23 @@ bool SeedConstraints(const VoxelOwnerMap& owner, const std::vector<std::int64_t>
 void SeedNeighbourhoodSamples(const VoxelValueFunction& value, const ImageGeometry& g,
   const std::vector<std::int64_t>& seedVoxels, double radius, std::vector<double>& samples)
 {
-  const int r = static_cast<int>(std::floor(radius));
-  const int rk = g.Is2D() ? 0 : r;
   for (std::int64_t v : seedVoxels)
   {
-    const int k = static_cast<int>(v / g.SliceStride());
-    const int j = static_cast<int>((v % g.SliceStride()) / g.Dims[0]);
-    const int i = static_cast<int>(v % g.Dims[0]);
-    for (int dk = -rk; dk <= rk; ++dk)
-      for (int dj = -r; dj <= r; ++dj)
-        for (int di = -r; di <= r; ++di)
-        {
-          if (di * di + dj * dj + dk * dk <= radius * radius && g.Contains(i + di, j + dj, k + dk))
-          {
-            samples.push_back(value(g.Index(i + di, j + dj, k + dk)));
-          }
-        }
+    ForEachVoxelWithin(g, v, radius, [&](std::int64_t u) { samples.push_back(value(u)); });
   }
+}
+
+std::vector<std::uint8_t> BorderVoxels(const ImageGeometry& g)
+{
+  std::vector<std::uint8_t> border(g.Size(), 0);
+  for (int k = 0; k < g.Dims[2]; ++k)
+    for (int j = 0; j < g.Dims[1]; ++j)
+      for (int i = 0; i < g.Dims[0]; ++i)
+      {
+        border[g.Index(i, j, k)] = i == 0 || j == 0 || i + 1 == g.Dims[0] || j + 1 == g.Dims[1] ||
+          (!g.Is2D() && (k == 0 || k + 1 == g.Dims[2]));
+      }
+  return border;
 }
 
 namespace
@@ -326,14 +326,7 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
     cut.Aborted = cut.Error.empty();
     return cut;
   }
-  std::vector<std::uint8_t> border(n, 0);
-  for (int k = 0; k < g.Dims[2]; ++k)
-    for (int j = 0; j < g.Dims[1]; ++j)
-      for (int i = 0; i < g.Dims[0]; ++i)
-      {
-        border[g.Index(i, j, k)] = i == 0 || j == 0 || i + 1 == g.Dims[0] || j + 1 == g.Dims[1] ||
-          (!g.Is2D() && (k == 0 || k + 1 == g.Dims[2]));
-      }
+  const std::vector<std::uint8_t> border = BorderVoxels(g);
   cut.ConnectivityChanged = ApplyConnectivity(ConnectivityFor(parameters.Connectivity, parameters.Task), cut.Label, pr.Edges, pr.Hard, border,
     SubProgress(progress, 0.95, 1.0), &cut.ObjectComponentVoxels);
   if (cut.ConnectivityChanged < 0)

@@ -9,6 +9,7 @@
 #include "SeedConnectivity.h"
 #include "SimplexMesh.h"
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -133,6 +134,29 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& geometry,
 
 // Empty when usable, else a sentence.
 std::string ValidateParameters(const SeededCutParameters& p);
+
+// f(voxel) for each voxel within `radius` (voxels, index space) of voxel v, the image's own in 2D.
+template <typename F>
+void ForEachVoxelWithin(const ImageGeometry& g, std::int64_t v, double radius, F&& f)
+{
+  const int r = static_cast<int>(std::floor(radius));
+  const int rk = g.Is2D() ? 0 : r;
+  const int k = static_cast<int>(v / g.SliceStride());
+  const int j = static_cast<int>((v % g.SliceStride()) / g.Dims[0]);
+  const int i = static_cast<int>(v % g.Dims[0]);
+  for (int dk = -rk; dk <= rk; ++dk)
+    for (int dj = -r; dj <= r; ++dj)
+      for (int di = -r; di <= r; ++di)
+      {
+        if (di * di + dj * dj + dk * dk <= radius * radius && g.Contains(i + di, j + dj, k + dk))
+        {
+          f(g.Index(i + di, j + dj, k + dk));
+        }
+      }
+}
+
+// 1 for the voxels on the image's border (its box faces), else 0.
+std::vector<std::uint8_t> BorderVoxels(const ImageGeometry& g);
 
 // Appends to `samples` the values of the voxels within `radius` (voxels) of each seed voxel.
 void SeedNeighbourhoodSamples(const VoxelValueFunction& value, const ImageGeometry& geometry,
