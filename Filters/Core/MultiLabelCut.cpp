@@ -166,7 +166,7 @@ std::vector<double> PottsWeights(const GraphEdges& edges, const std::vector<doub
 }
 
 // Adds the seeds' geodesic spatial term for L labels to `cost` (nodes x L), each node's share
-// weighted by lambda * size; `cache` keeps each label's distances while its seed nodes stay.
+// weighted by lambda * size; `cache` keeps each label's distances and updates them for its seed edits.
 bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, const ChannelBins& bins,
   const std::vector<double>* step, const std::vector<std::int16_t>& hard, int L, const SeedGeodesicParameters& geo,
   double lambda, const std::vector<double>& size, std::vector<double>& cost, const ProgressFunction& progress,
@@ -193,26 +193,11 @@ bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, 
   {
     kind[p] = static_cast<std::uint8_t>(hard[p] + 1);
   }
-  const bool keep = cache && cache->Hard.size() == hard.size() && static_cast<int>(cache->Distance.size()) == L;
-  std::vector<std::vector<double>> distance(L);
-  for (int l = 0; l < L; ++l)
+  const std::vector<std::vector<double>> distance =
+    SeedKindDistances(graph, kind, L, 1.0, geo.LengthWeight, progress, cache ? &cache->Geodesic : nullptr);
+  if (distance.empty())
   {
-    bool same = keep;
-    for (std::int64_t p = 0; same && p < n; ++p)
-    {
-      same = (cache->Hard[p] == l) == (hard[p] == l);
-    }
-    if (same && static_cast<std::int64_t>(cache->Distance[l].size()) == n)
-    {
-      distance[l] = cache->Distance[l];
-      continue;
-    }
-    distance[l] = GeodesicDistances(graph, kind, static_cast<std::uint8_t>(l + 1), 1.0, geo.LengthWeight,
-      SubProgress(progress, static_cast<double>(l) / L, static_cast<double>(l + 1) / L));
-    if (distance[l].empty())
-    {
-      return false;
-    }
+    return false;
   }
   const double mix = 0.01;
   for (std::int64_t p = 0; p < n; ++p)
@@ -233,11 +218,6 @@ bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, 
                                  : (total > 0.0 ? (std::isfinite(d) ? 1.0 / d / total : 0.0) : 1.0 / L);
       cost[p * L + l] += s * -geo.Weight * std::log(mix + (1.0 - L * mix) * share);
     }
-  }
-  if (cache)
-  {
-    cache->Distance = std::move(distance);
-    cache->Hard = hard;
   }
   return true;
 }

@@ -14,6 +14,7 @@
 
 #include "AlphaExpansion.h"
 #include "ElementRasterizer.h"
+#include "SeedGeodesics.h"
 #include "SuperVoxelCut.h"
 
 #include <cstdint>
@@ -98,13 +99,16 @@ struct MultiLabelResult
 };
 
 // What a multi-label cut of one graph keeps for the next: the last labelling (the next cut starts
-// from it) and its seeds' geodesic distances per label.
+// from it) and its seeds' geodesic distances per label (updated, not redone, after a seed edit).
 struct MultiLabelCache
 {
   std::vector<std::uint8_t> Label;
-  std::vector<std::int16_t> Hard;
-  std::vector<std::vector<double>> Distance;
-  void Clear() { *this = MultiLabelCache(); }
+  SeedGeodesicCache Geodesic;
+  void Clear()
+  {
+    this->Label.clear();
+    this->Geodesic.Clear();
+  }
 };
 
 // The super-voxel cut with labelled seeds: `runs` and `mean` (elements x channels) from the image's

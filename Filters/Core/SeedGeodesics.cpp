@@ -257,8 +257,9 @@ struct SeedGeodesicCache::Kept
   std::vector<double> Value, Step;
   double Scale = 0.0, LengthWeight = 0.0;
   std::unique_ptr<Adjacency> Neighbours;
-  std::array<std::vector<std::int64_t>, 2> Seeds;
-  std::array<DistanceField, 2> Field;
+  // Per seed kind (index kind - 1).
+  std::vector<std::vector<std::int64_t>> Seeds;
+  std::vector<DistanceField> Field;
 
   bool Matches(const GeodesicGraph& g, double scale, double lengthWeight) const
   {
@@ -295,20 +296,12 @@ std::vector<double> GeodesicDistances(const GeodesicGraph& graph, const std::vec
   return std::move(field.Distance);
 }
 
-bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard, double scale,
-  const SeedGeodesicParameters& par, const ParallelFor& parallel, std::vector<double>& costObject,
-  std::vector<double>& costBackground, const ProgressFunction& progress, SeedGeodesicCache* cache)
+// With the graph copied when there is a cache, and `kinds` fields at least.
+std::shared_ptr<SeedGeodesicCache::Kept> SeedGeodesicCache::Take(const GeodesicGraph& graph, double scale, double lengthWeight,
+  int kinds, SeedGeodesicCache* cache)
 {
-  costObject.clear();
-  costBackground.clear();
-  const std::array<std::vector<std::int64_t>, 2> seeds{ { SeedNodes(hard, 1), SeedNodes(hard, 2) } };
-  if (par.Weight <= 0.0 || seeds[0].empty() || seeds[1].empty() || graph.Nodes == 0)
-  {
-    return true;
-  }
-  scale = UsableScale(scale);
   std::shared_ptr<SeedGeodesicCache::Kept> kept = cache ? cache->State : nullptr;
-  if (!kept || !kept->Matches(graph, scale, par.LengthWeight))
+  if (!kept || !kept->Matches(graph, scale, lengthWeight))
   {
     kept = std::make_shared<SeedGeodesicCache::Kept>();
     kept->Neighbours.reset(new Adjacency(*graph.Edges, graph.Nodes, graph.Step));
@@ -326,13 +319,62 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
         kept->Step = *graph.Step;
       }
       kept->Scale = scale;
-      kept->LengthWeight = par.LengthWeight;
+      kept->LengthWeight = lengthWeight;
     }
+  }
+  if (static_cast<int>(kept->Field.size()) < kinds)
+  {
+    kept->Field.resize(kinds);
+    kept->Seeds.resize(kinds);
   }
   if (cache)
   {
-    cache->State.reset(); // until both distances are whole again
+    cache->State.reset();
   }
+  return kept;
+}
+
+std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
+  int kinds, double scale, double lengthWeight, const ProgressFunction& progress, SeedGeodesicCache* cache)
+{
+  scale = UsableScale(scale);
+  std::shared_ptr<SeedGeodesicCache::Kept> kept = SeedGeodesicCache::Take(graph, scale, lengthWeight, kinds, cache);
+  for (int k = 0; k < kinds; ++k)
+  {
+    const std::vector<std::int64_t> seeds = SeedNodes(hard, static_cast<std::uint8_t>(k + 1));
+    if ((kept->Seeds[k] != seeds || kept->Field[k].Distance.empty()) &&
+      !UpdateField(graph, *kept->Neighbours, kept->Seeds[k], seeds, scale, lengthWeight, kept->Field[k],
+        SubProgress(progress, static_cast<double>(k) / kinds, static_cast<double>(k + 1) / kinds)))
+    {
+      return {};
+    }
+    kept->Seeds[k] = seeds;
+  }
+  std::vector<std::vector<double>> distance(kinds);
+  for (int k = 0; k < kinds; ++k)
+  {
+    distance[k] = kept->Field[k].Distance;
+  }
+  if (cache)
+  {
+    cache->State = kept;
+  }
+  return distance;
+}
+
+bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard, double scale,
+  const SeedGeodesicParameters& par, const ParallelFor& parallel, std::vector<double>& costObject,
+  std::vector<double>& costBackground, const ProgressFunction& progress, SeedGeodesicCache* cache)
+{
+  costObject.clear();
+  costBackground.clear();
+  const std::array<std::vector<std::int64_t>, 2> seeds{ { SeedNodes(hard, 1), SeedNodes(hard, 2) } };
+  if (par.Weight <= 0.0 || seeds[0].empty() || seeds[1].empty() || graph.Nodes == 0)
+  {
+    return true;
+  }
+  scale = UsableScale(scale);
+  std::shared_ptr<SeedGeodesicCache::Kept> kept = SeedGeodesicCache::Take(graph, scale, par.LengthWeight, 2, cache);
   // Per kind: the kept distances updated for the seeds added and removed, or afresh.
   std::array<bool, 2> update{ { kept->Seeds[0] != seeds[0] || kept->Field[0].Distance.empty(),
     kept->Seeds[1] != seeds[1] || kept->Field[1].Distance.empty() } };
@@ -363,7 +405,8 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
   {
     return false;
   }
-  kept->Seeds = seeds;
+  kept->Seeds[0] = seeds[0];
+  kept->Seeds[1] = seeds[1];
   const std::vector<double>& toObject = kept->Field[0].Distance;
   const std::vector<double>& toBackground = kept->Field[1].Distance;
   constexpr double mix = 0.01;

@@ -59,9 +59,15 @@ public:
   struct Kept;
 
 private:
+  friend std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph&, const std::vector<std::uint8_t>&, int,
+    double, double, const ProgressFunction&, SeedGeodesicCache*);
   friend bool SeedGeodesicCosts(const GeodesicGraph&, const std::vector<std::uint8_t>&, double, const SeedGeodesicParameters&,
     const ParallelFor&, std::vector<double>&, std::vector<double>&, const ProgressFunction&, SeedGeodesicCache*);
   std::shared_ptr<Kept> State;
+  // The kept distances when they were made on this graph, else a fresh record; the cache is empty
+  // until the caller stores the record back whole.
+  static std::shared_ptr<Kept> Take(const GeodesicGraph& graph, double scale, double lengthWeight, int kinds,
+    SeedGeodesicCache* cache);
 };
 
 // The spatial term per voxel of each node (costObject, costBackground), from the distances to the
@@ -71,6 +77,14 @@ private:
 bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard, double scale,
   const SeedGeodesicParameters& parameters, const ParallelFor& parallel, std::vector<double>& costObject,
   std::vector<double>& costBackground, const ProgressFunction& progress = NoProgress(),
+  SeedGeodesicCache* cache = nullptr);
+
+// Distances of every node from the seeds of each kind 1..kinds (hard[p] == kind), kept in `cache`
+// (optional) as SeedGeodesicCosts keeps its two kinds: a kind whose seeds changed is updated (added
+// seeds run Dijkstra from themselves, nodes rooted at removed ones restart from their neighbours),
+// the others reused. Empty when progress asks to abort.
+std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
+  int kinds, double scale, double lengthWeight, const ProgressFunction& progress = NoProgress(),
   SeedGeodesicCache* cache = nullptr);
 
 // Empty when usable, else a sentence.

@@ -4,6 +4,7 @@
 #include "ElementRasterizer.h"
 #include "MultiLabelCut.h"
 #include "SimplexMesh.h"
+#include "SeedGeodesics.h"
 #include "SurfaceSmoothing.h"
 
 #include <gtest/gtest.h>
@@ -552,4 +553,43 @@ TEST(MultiLabelSurface, AJunctionCurveMovesAlongItselfIn3D)
   for (std::int64_t e = 0; e < mesh.NumberOfElements(); ++e)
     EXPECT_GT(SignedMeasure(r.Points, mesh.Cell(e), 4), 0.0) << "element " << e << " inverted";
   EXPECT_NEAR(r.ObjectMeasureAfter / r.ObjectMeasureBefore, 1.0, 0.1);
+}
+
+TEST(MultiLabel, KeptDistancesOfEveryLabelEqualFreshOnes)
+{
+  // Three seed kinds on a noisy grid, through one cache: seeds added, removed and moved, one kind at
+  // a time and together; every kind's distances equal those made afresh.
+  const ImageGeometry g = Grid(40, 30);
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<double> value(g.Size());
+  for (double& v : value)
+    v = 10.0 * u(rng);
+  const GraphEdges edges = GraphEdges::Grid(40, 30, 1);
+  GeodesicGraph graph;
+  graph.Edges = &edges;
+  graph.Value = value.data();
+  graph.Nodes = g.Size();
+  std::vector<std::uint8_t> hard(g.Size(), 0);
+  hard[g.Index(3, 3, 0)] = 1;
+  hard[g.Index(30, 20, 0)] = 2;
+  hard[g.Index(20, 5, 0)] = 3;
+  SeedGeodesicCache cache;
+  const std::vector<std::vector<std::pair<int, int>>> edits = {
+    {}, { { g.Index(10, 10, 0), 1 } }, { { g.Index(3, 3, 0), 0 } }, { { g.Index(25, 25, 0), 3 }, { g.Index(20, 5, 0), 0 } },
+    { { g.Index(30, 20, 0), 0 }, { g.Index(31, 20, 0), 2 } }, {}
+  };
+  for (const auto& edit : edits)
+  {
+    for (const auto& e : edit)
+      hard[e.first] = static_cast<std::uint8_t>(e.second);
+    const auto kept = SeedKindDistances(graph, hard, 3, 10.0, 0.01, NoProgress(), &cache);
+    ASSERT_EQ(kept.size(), 3u);
+    for (int k = 0; k < 3; ++k)
+    {
+      const std::vector<double> fresh = GeodesicDistances(graph, hard, static_cast<std::uint8_t>(k + 1), 10.0, 0.01);
+      for (std::int64_t p = 0; p < g.Size(); ++p)
+        ASSERT_NEAR(kept[k][p], fresh[p], 1e-12 * (1.0 + fresh[p])) << "kind " << k + 1 << " node " << p;
+    }
+  }
 }
