@@ -184,12 +184,31 @@ def write(grid, base, unit="mm", formats=tuple(FORMATS)):
                     for i, (L, (_, c)) in enumerate(zip(present, blocks))}
             abaqus_nodes = {name.replace("|", "__"): ids for name, ids in nodes.items()}
             meshio.write(path, meshio.Mesh(points, blocks, cell_sets=sets, point_sets=abaqus_nodes), file_format="abaqus")
+            _abaqus_node_fields(path)
         elif fmt == "exodus":
             meshio.write(path, meshio.Mesh(points, blocks, point_sets=nodes), file_format="exodus")
             _exodus_info(path, ["FeatureMesh labelled mesh", "length unit: %s" % unit] +
                          ["element block %d: %s" % (i + 1, region[L]) for i, L in enumerate(present)])
         written[fmt] = path
     return written
+
+
+def _abaqus_node_fields(path, digits=9):
+    """Rewrites the *NODE lines of an Abaqus deck with `digits` significant digits: meshio writes
+    22-character coordinates, and CalculiX reads fields of at most 20 characters ("*ERROR reading
+    *NODE"). Nine digits keep a millimetre mesh of a metre-sized box to a nanometre."""
+    with open(path) as f:
+        lines = f.read().split("\n")
+    in_nodes = False
+    for i, line in enumerate(lines):
+        if line.startswith("*"):
+            in_nodes = line.strip().upper().startswith("*NODE") and not line.strip().upper().startswith("*NODE ")
+            continue
+        if in_nodes and line.strip():
+            fields = line.split(",")
+            lines[i] = ", ".join([fields[0].strip()] + ["%.*g" % (digits, float(x)) for x in fields[1:]])
+    with open(path, "w") as f:
+        f.write("\n".join(lines))
 
 
 def _exodus_info(path, lines):
