@@ -442,6 +442,19 @@ TEST(FeatureNodes, NegativeSpacing)
   image->SetSpacing(1.0, -0.5, 1.0);
   FeatureNodes(image, [&](auto& run, vtkPolyData* out) { ExpectNodesInside(run, out, image, 20); });
 }
+TEST(DelaunayImageMesh, SpacingBeyondTheExactRange)
+{
+  auto image = Ball();
+  image->SetSpacing(1e30, 1e30, 1e30);
+  DelaunayMesh(NodesOf(Ball()), image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "1e-12 and 1e12", out); });
+}
+TEST(DelaunayImageMesh, LargeSpacingTilesExactly)
+{
+  auto image = Ball();
+  image->SetSpacing(1e9, 2e9, 1e9);
+  auto nodes = NodesOf(image);
+  DelaunayMesh(nodes, image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectTiling(run, out, image); });
+}
 TEST(FeatureNodes, ZeroSpacing)
 {
   auto image = Disc();
@@ -564,9 +577,29 @@ TEST(DelaunayImageMesh, NodesOutside)
 }
 TEST(DelaunayImageMesh, NodesOffVoxelCentres)
 {
+  // Off the lattice (as stage 3 leaves nodes): meshed, every voxel owned once.
   auto image = Disc();
-  DelaunayMesh(Points({ World(image, 0, 0, 0), World(image, 9.5, 0, 0), World(image, 0, 9.25, 0), World(image, 20, 20, 0) }),
-    image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "voxel centres", out); });
+  DelaunayMesh(Points({ World(image, 0, 0, 0), World(image, 9.5, 0, 0), World(image, 0, 9.25, 0), World(image, 20, 20, 0),
+                 World(image, 31.3, 40.7, 0), World(image, 50.5, 12.5, 0) }),
+    image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectTiling(run, out, image); });
+}
+TEST(DelaunayImageMesh, NodesOffVoxelCentresIn3D)
+{
+  auto image = Ball();
+  auto nodes = NodesOf(image);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> jitter(-0.45, 0.45);
+  for (vtkIdType i = 0; i < nodes->GetNumberOfPoints(); ++i)
+  {
+    double x[3];
+    nodes->GetPoint(i, x);
+    bool box = false;
+    for (int a = 0; a < 3; ++a)
+      box = box || x[a] <= 0.0 || x[a] >= 39.0;
+    if (!box)
+      nodes->GetPoints()->SetPoint(i, x[0] + jitter(rng), x[1] + jitter(rng), x[2] + jitter(rng));
+  }
+  DelaunayMesh(nodes, image, [&](auto& run, vtkUnstructuredGrid* out) { ExpectTiling(run, out, image); });
 }
 TEST(DelaunayImageMesh, NodesOffThe2DPlane)
 {
@@ -642,6 +675,18 @@ TEST(DelaunayImageMesh, RefinementParametersOutOfRange)
       m->SetQualityRefinement(true);
       m->SetRadiusEdgeRatio(0.5);
     });
+}
+// TetGen's refinement did not return with these (the matrix; the liver's nodes, 25 degrees).
+TEST(DelaunayImageMesh, RefinementThatNeedNotTerminate)
+{
+  auto image = Ball();
+  for (const auto& set : std::vector<std::function<void(vtkDelaunayImageMesh*)>>{
+         [](vtkDelaunayImageMesh* m) { m->SetRadiusEdgeRatio(1.0); }, [](vtkDelaunayImageMesh* m) { m->SetMinDihedralAngle(25); } })
+    DelaunayMesh(NodesOf(image), image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "may not terminate", out); },
+      [&](vtkDelaunayImageMesh* m) {
+        m->SetQualityRefinement(true);
+        set(m);
+      });
 }
 
 //------------------------------------------------------------------------------------------------
@@ -797,6 +842,14 @@ TEST(SuperVoxelCut, ConflictingSeeds)
 {
   Case2D c;
   SuperVoxelCut(c.mesh, c.object, c.object, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "both"); });
+}
+TEST(SuperVoxelCut, SeedsOfBothKindsInOneElement)
+{
+  // Two voxels of one element of the disc's interior (it spans voxels 31..35 x 28..30), one seed
+  // of each kind: the element cannot be both.
+  Case2D c;
+  SuperVoxelCut(c.mesh, Points({ World(c.image, 32, 29, 0) }), Points({ World(c.image, 34, 28, 0), World(c.image, 3, 3, 0) }),
+    c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "holds both"); });
 }
 TEST(SuperVoxelCut, ThousandsOfSeeds)
 {
