@@ -31,7 +31,7 @@ struct BoykovJollyParameters
   // differences over all graph edges.
   double Sigma = 0.0;
   // Weight of the region term against the boundary term (per voxel against per voxel face). 0.2
-  // has the best mean Dice of both cuts over the shared cases (README, "The cut's energy").
+  // has the best mean Dice of both cuts over the shared cases (docs/cut.md).
   double Lambda = 0.2;
   // Kernel bandwidth of the seed histograms as a multiple of Silverman's rule.
   double Bandwidth = 1.0;

@@ -41,7 +41,7 @@ struct LabelledSeeds
 struct MultiLabelParameters
 {
   // Independent: with a few seeds per label it beat the joint density on the two-channel brain
-  // tumour cases (README, "Several labels").
+  // tumour cases (docs/multilabel.md).
   ChannelModel Channels = ChannelModel::Independent;
   // Most cycles over the labels.
   int MaxCycles = 8;

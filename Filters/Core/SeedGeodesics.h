@@ -22,7 +22,7 @@ struct SeedGeodesicParameters
 {
   // Weight of the spatial term against the appearance term (both per voxel, in nats); 0 = off.
   // 1.5 and 0.005: of the weights and lengths tried on the three shared object cases, the pair that
-  // keeps the Delaunay and the smoothed mesh's Dice closest (README, "The seeds' spatial term").
+  // keeps the Delaunay and the smoothed mesh's Dice closest (docs/cut.md, "The seeds' spatial term").
   double Weight = 1.5;
   // Length of one voxel of travel, in units of the intensity range: a path through a homogeneous
   // region costs about this per voxel, so seeds reach far across flat regions and stop at edges.

@@ -1,6 +1,6 @@
 """Several labels: the bundled abdomen CT (liver, spleen, two kidneys, stomach) from its seeds.csv
 (x,y,z,label) straight from ParaView's CSV reader into both cuts; Dice floors per label and on the
-mean (measured values - 0.02, README "Several labels"); every seed keeps its label; a seed edit
+mean (measured values - 0.02, docs/multilabel.md); every seed keeps its label; a seed edit
 re-cuts the kept mesh; stage 6 smooths every interface with no inverted element; the FEM files read
 back in meshio with a region per label named after it and a tag per pair of touching labels. The
 two-channel BraTS tumour regions (shared data only) keep their mean floors."""

@@ -1,7 +1,7 @@
 """FEM export of a labelled mesh (Segmentation Surface Smoothing's output 1, or the Super-Voxel Cut's
 output 0) through meshio: Gmsh, Medit, Abaqus and Exodus II, with one tag table for all of them.
 
-Tags (the one source of truth; README "FEM export" lists them):
+Tags (the one source of truth; README "FEM export" and docs/surface.md list them):
 - regions: label L is Gmsh physical group L + 1 (Gmsh reserves 0) named after the label (the grid's
   LabelNames field data, else REGION_NAMES, else label_L); Medit ref L on the elements; Abaqus element
   set and Exodus element block of the same name.
