@@ -80,12 +80,14 @@ def main():
         ap.error("give --object-seeds and --background-seeds, or --seeds")
     fm.load_plugin(args.plugin, ns=globals())
     os.makedirs(args.out, exist_ok=True)
-    name = os.path.basename(os.path.dirname(os.path.abspath(args.image))) if os.path.basename(args.image).startswith("image.") else os.path.splitext(os.path.basename(args.image))[0]
+    stem = os.path.basename(args.image)
+    stem = stem[: -len(".nii.gz")] if stem.lower().endswith(".nii.gz") else os.path.splitext(stem)[0]
+    name = os.path.basename(os.path.dirname(os.path.abspath(args.image))) if stem == "image" else stem
     base = os.path.join(args.out, name)
 
     times = {}
     t = time.perf_counter()
-    image = ps.OpenDataFile(args.image)
+    image = fm.open_image(args.image)
     image.UpdatePipeline()
     times["read"] = time.perf_counter() - t
     array = image.PointData.keys()[0]
@@ -180,7 +182,7 @@ def main():
               # face-connected components and quality histogram; the files and their unit.
               "fem": dict(fem.report(fem_mesh), unit=args.unit, files=fem_files)}
     if args.truth:
-        truth = ps.OpenDataFile(args.truth)
+        truth = fm.open_image(args.truth)
         T = v2n(sm.Fetch(truth).GetPointData().GetScalars())
         L = v2n(labels.GetPointData().GetScalars())
         if T.max() > 1:

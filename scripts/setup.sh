@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 packages=(cmake g++ make paraview-dev python3-paraview qtbase5-dev qttools5-dev libqt5svg5-dev libqt5x11extras5-dev
   qtxmlpatterns5-dev-tools libutfcpp-dev libdouble-conversion-dev mpi-default-dev libglew-dev libtiff-dev
-  libeigen3-dev libcgal-dev libtet1.5-dev libmaxflow-dev libgtest-dev python3-numpy python3-scipy python3-skimage python3-meshio python3-netcdf4 python3-matplotlib xvfb xauth
+  libeigen3-dev libcgal-dev libtet1.5-dev libmaxflow-dev libgtest-dev python3-numpy python3-scipy python3-skimage python3-meshio python3-netcdf4 python3-matplotlib python3-nibabel xvfb xauth
   calculix-ccx)
 missing=()
 for p in "${packages[@]}"; do

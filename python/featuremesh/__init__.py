@@ -22,7 +22,7 @@ DATA = os.environ.get("FEATUREMESH_DATA", os.path.join(ROOT, "Data"))
 SHARED = os.environ.get("FEATUREMESH_SHARED_DATA", os.path.join(os.path.dirname(ROOT), "shared", "data"))
 
 __all__ = ["ROOT", "DATA", "SHARED", "np", "v2n", "find_plugin", "load_plugin", "cases", "case_dir", "seeds", "fetch",
-           "labels", "dice", "case_task", "Case", "multilabel_cases", "MultiLabelCase", "label_names_from_csv"]
+           "labels", "dice", "case_task", "Case", "open_image", "multilabel_cases", "MultiLabelCase", "label_names_from_csv"]
 
 
 def find_plugin():
@@ -88,6 +88,42 @@ def seeds(arg):
     return ps.PolyPointSource(Points=coords)
 
 
+NIFTI_SUFFIXES = (".nii", ".nii.gz")
+
+
+def open_image(path):
+    """A ParaView source of the image at `path`: NIfTI (.nii, .nii.gz) through nibabel, every other
+    format through ParaView's readers. NIfTI's affine is RAS; it becomes the LPS origin, spacing and
+    direction matrix that ITK and MetaImage use, so that the world coordinates of a case's seeds mean
+    the same voxels in its .mha and in its .nii. Channels (a fourth axis) become components."""
+    if not path.lower().endswith(NIFTI_SUFFIXES):
+        return ps.OpenDataFile(path)
+    import nibabel
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    nifti = nibabel.load(path)
+    data = np.asanyarray(nifti.dataobj)
+    if data.ndim < 3:
+        data = data.reshape(data.shape + (1,) * (3 - data.ndim))
+    lps = np.diag([-1.0, -1.0, 1.0, 1.0]) @ nifti.affine
+    spacing = np.linalg.norm(lps[:3, :3], axis=0)
+    direction = lps[:3, :3] / spacing
+    channels = data.shape[3] if data.ndim > 3 else 1
+    image = vtkImageData()
+    image.SetDimensions(*data.shape[:3])
+    image.SetSpacing(*spacing)
+    image.SetOrigin(*lps[:3, 3])
+    image.SetDirectionMatrix(*direction.ravel())
+    # Voxel (i, j, k) at i + nx (j + ny k): NIfTI's first axis runs fastest, as VTK's does.
+    values = numpy_to_vtk(np.ascontiguousarray(data.reshape((-1, channels), order="F")), deep=True)
+    values.SetName("NIfTI")
+    image.GetPointData().SetScalars(values)
+    source = ps.TrivialProducer()
+    source.GetClientSideObject().SetOutput(image)
+    source.UpdatePipeline()
+    return source
+
+
 def fetch(proxy, port=0):
     return sm.Fetch(proxy, idx=port)
 
@@ -111,7 +147,7 @@ class Case:
     def __init__(self, folder, image=None, object_seeds=None, background_seeds=None):
         self.folder = folder
         self.name = os.path.basename(os.path.normpath(folder))
-        self.image = ps.OpenDataFile(image or os.path.join(folder, "image.mha"))
+        self.image = open_image(image or os.path.join(folder, "image.mha"))
         self.image.UpdatePipeline()
         self.scalars = ["POINTS", self.image.PointData.keys()[0]]
         self.object_seeds = seeds(object_seeds or os.path.join(folder, "seeds_object.csv"))
