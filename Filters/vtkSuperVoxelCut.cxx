@@ -368,6 +368,10 @@ void vtkSuperVoxelCut::WriteLabels(vtkUnstructuredGrid* input, const std::vector
   BoundaryPolyData(input->GetPoints(), boundaryFaces, data.Mesh.VerticesPerCell() - 1, vtkPolyData::GetData(outputVector, 1));
   // Output 2: the labels on the image grid.
   vtkImageData* labelImage = vtkImageData::GetData(outputVector, 2);
+  // Not the mesh's field data the pipeline passed on (its per-voxel owner map would make a saved
+  // label image as large as the mesh's): the image carries its own frame and the cut's summaries.
+  labelImage->GetFieldData()->Initialize();
+  vtkPolyData::GetData(outputVector, 1)->GetFieldData()->Initialize();
   SetImageFrame(labelImage, geometry);
   vtkNew<vtkUnsignedCharArray> voxels;
   voxels->SetName(names::Label);

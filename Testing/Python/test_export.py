@@ -46,3 +46,13 @@ for case in ("nuclei-dsb2018", "liver-ct-totalseg"):
     r.SetFileName(path)
     r.Update()
     ft.check(ft.np.array_equal(ft.array(r.GetOutput()), ft.array(labels)), "%s: the label image round-trips as .vti" % case)
+
+# The label image a user saves holds its labels, not the mesh's per-voxel owner map (issue 28):
+# ParaView's SaveData in its default format, under twice the label bytes.
+c = ft.fm.Case(ft.case_dir("liver-ct-totalseg"))
+_, mesh, cut = c.pipeline()
+path = os.path.join(out, "liver_labels_saved.vti")
+ft.ps.SaveData(path, proxy=ft.ps.OutputPort(cut, 2))
+voxels = ft.fetch(cut, 2).GetNumberOfPoints()
+ft.check(os.path.getsize(path) < 2 * voxels, "the saved label image is %d bytes for %d voxels" % (os.path.getsize(path), voxels))
+ft.check(ft.fetch(cut, 2).GetFieldData().GetArray("VoxelOwner") is None, "the label image carries no VoxelOwner")
