@@ -459,7 +459,8 @@ void WriteImageMesh(const SimplexMesh& mesh, const ElementStatistics& stats, con
   addCellArray(names::Interpolated, interpolated.GetPointer(), stats.Interpolated);
   addCellArray(is2D ? names::MinAngle : names::MinDihedralAngle, angle.GetPointer(), minAngle);
   addCellArray(names::RadiusRatio, ratio.GetPointer(), radiusRatio);
-  output->GetCellData()->SetActiveScalars(names::MeanIntensity);
+  // ParaView colours a mesh by its active scalars: the elements' quality, not the nodes' types.
+  output->GetCellData()->SetActiveScalars(is2D ? names::MinAngle : names::MinDihedralAngle);
 
   // Field data: a summary a user (or a report) can read without recomputing, and the frame.
   AddFieldValue(output, names::NumberOfNodes, static_cast<double>(nPts));
@@ -500,6 +501,8 @@ void PassNodeArrays(vtkPointData* in, vtkIdType nIn, vtkPointData* out, vtkIdTyp
   const int added = static_cast<int>(NodeType::Added);
   setAdded(names::NodeType, added, added);
   setAdded(names::Fixed, 1, 0);
+  // A mesh is coloured by its elements' quality (WriteImageMesh), not by the nodes' types.
+  out->SetActiveAttribute(-1, vtkDataSetAttributes::SCALARS);
 }
 
 void RequestWholeImage(vtkInformationVector* portVector)

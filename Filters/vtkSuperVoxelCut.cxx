@@ -364,6 +364,7 @@ void vtkSuperVoxelCut::WriteLabels(vtkUnstructuredGrid* input, const std::vector
   std::copy(labels.begin(), labels.end(), label->GetPointer(0));
   output->GetCellData()->AddArray(label);
   output->GetCellData()->SetActiveScalars(names::Label);
+  output->GetPointData()->SetActiveAttribute(-1, vtkDataSetAttributes::SCALARS); // coloured by Label
   // Output 1: the boundary, on the mesh's points (2D polylines, 3D triangles outward).
   BoundaryPolyData(input->GetPoints(), boundaryFaces, data.Mesh.VerticesPerCell() - 1, vtkPolyData::GetData(outputVector, 1));
   // Output 2: the labels on the image grid.
