@@ -260,11 +260,13 @@ std::vector<std::array<double, 3>> PointsOf(vtkPointSet* points)
   return p;
 }
 
-bool ObjectAndBackgroundVoxels(vtkPointSet* object, vtkPointSet* background, const ImageGeometry& geometry,
+bool ObjectAndBackgroundVoxels(vtkDataObject* object, vtkDataObject* background, const ImageGeometry& geometry,
   std::vector<std::int64_t>& objectVoxels, std::vector<std::int64_t>& backgroundVoxels, std::string& error)
 {
-  return SeedVoxels(PointsOf(object), geometry, "object", objectVoxels, error) &&
-    SeedVoxels(PointsOf(background), geometry, "background", backgroundVoxels, error);
+  std::vector<std::array<double, 3>> objectPoints, backgroundPoints;
+  return SeedPointsOf(object, objectPoints, error) && SeedPointsOf(background, backgroundPoints, error) &&
+    SeedVoxels(objectPoints, geometry, "object", objectVoxels, error) &&
+    SeedVoxels(backgroundPoints, geometry, "background", backgroundVoxels, error);
 }
 
 namespace
@@ -299,38 +301,51 @@ vtkDataArray* NumericColumn(vtkFieldData* data, const char* name)
 }
 } // namespace
 
+bool SeedPointsOf(vtkDataObject* seeds, std::vector<std::array<double, 3>>& world, std::string& error)
+{
+  world.clear();
+  if (!seeds)
+  {
+    return true;
+  }
+  if (auto* points = vtkPointSet::SafeDownCast(seeds))
+  {
+    world = PointsOf(points);
+    return true;
+  }
+  auto* table = vtkTable::SafeDownCast(seeds);
+  if (!table)
+  {
+    error = "the seeds must be a point set or a table (columns x, y, z).";
+    return false;
+  }
+  vtkDataArray* xyz[3] = { NumericColumn(table->GetRowData(), "x"), NumericColumn(table->GetRowData(), "y"),
+    NumericColumn(table->GetRowData(), "z") };
+  if (table->GetNumberOfRows() > 0 && (!xyz[0] || !xyz[1]))
+  {
+    error = "the seed table needs numeric columns x, y (and z in 3D).";
+    return false;
+  }
+  for (vtkIdType r = 0; r < table->GetNumberOfRows(); ++r)
+  {
+    world.push_back({ { xyz[0]->GetComponent(r, 0), xyz[1]->GetComponent(r, 0), xyz[2] ? xyz[2]->GetComponent(r, 0) : 0.0 } });
+  }
+  return true;
+}
+
 bool LabelledSeedVoxels(vtkDataObject* seeds, const char* labelArray, const ImageGeometry& geometry,
   LabelledSeeds& out, std::string& error)
 {
   out = LabelledSeeds();
   const std::string name = labelArray && *labelArray ? labelArray : names::Label;
   std::vector<std::array<double, 3>> world;
-  vtkDataArray* label = nullptr;
-  if (auto* points = vtkPointSet::SafeDownCast(seeds))
+  if (!SeedPointsOf(seeds, world, error))
   {
-    world = PointsOf(points);
-    label = NumericColumn(points->GetPointData(), name.c_str());
-  }
-  else if (auto* table = vtkTable::SafeDownCast(seeds))
-  {
-    vtkDataArray* xyz[3] = { NumericColumn(table->GetRowData(), "x"), NumericColumn(table->GetRowData(), "y"),
-      NumericColumn(table->GetRowData(), "z") };
-    if (!xyz[0] || !xyz[1])
-    {
-      error = "the seed table needs numeric columns x, y (and z in 3D).";
-      return false;
-    }
-    for (vtkIdType r = 0; r < table->GetNumberOfRows(); ++r)
-    {
-      world.push_back({ { xyz[0]->GetComponent(r, 0), xyz[1]->GetComponent(r, 0), xyz[2] ? xyz[2]->GetComponent(r, 0) : 0.0 } });
-    }
-    label = NumericColumn(table->GetRowData(), name.c_str());
-  }
-  else
-  {
-    error = "the seeds must be a point set or a table.";
     return false;
   }
+  vtkFieldData* columns = vtkPointSet::SafeDownCast(seeds) ? static_cast<vtkFieldData*>(vtkPointSet::SafeDownCast(seeds)->GetPointData())
+                                                             : vtkTable::SafeDownCast(seeds)->GetRowData();
+  vtkDataArray* label = NumericColumn(columns, name.c_str());
   if (!label || label->GetNumberOfComponents() != 1)
   {
     error = "the seeds have no one-component numeric array named " + name + " (0 background, 1..k objects).";

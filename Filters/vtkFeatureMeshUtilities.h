@@ -122,9 +122,14 @@ void SetImageFrame(vtkImageData* image, const ImageGeometry& geometry);
 // The points of a point set, world coordinates (empty for null).
 std::vector<std::array<double, 3>> PointsOf(vtkPointSet* points);
 
-// The voxels of the object and background seed point sets (SeedVoxels for each); false with the
-// sentence of the first that fails.
-bool ObjectAndBackgroundVoxels(vtkPointSet* object, vtkPointSet* background, const ImageGeometry& geometry,
+// The world positions of seeds given as a point set, or as a table with columns x, y (and z),
+// matched without case, as ParaView's CSV reader gives them (empty for null); false with a sentence
+// for another data type or a table without the columns.
+bool SeedPointsOf(vtkDataObject* seeds, std::vector<std::array<double, 3>>& world, std::string& error);
+
+// The voxels of the object and background seeds (point sets or tables, SeedPointsOf; SeedVoxels for
+// each); false with the sentence of the first that fails.
+bool ObjectAndBackgroundVoxels(vtkDataObject* object, vtkDataObject* background, const ImageGeometry& geometry,
   std::vector<std::int64_t>& objectVoxels, std::vector<std::int64_t>& backgroundVoxels, std::string& error);
 
 // Labelled seeds from a point set (a point array named `labelArray`) or a table (columns x, y, z and

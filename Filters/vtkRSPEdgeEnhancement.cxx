@@ -44,7 +44,7 @@ vtkRSPEdgeEnhancement::vtkRSPEdgeEnhancement()
 
 int vtkRSPEdgeEnhancement::FillInputPortInformation(int port, vtkInformation* info)
 {
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port == 0 ? "vtkImageData" : "vtkPointSet");
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port == 0 ? "vtkImageData" : "vtkDataObject");
   return 1;
 }
 
@@ -92,8 +92,8 @@ int vtkRSPEdgeEnhancement::RequestData(vtkInformation*, vtkInformationVector** i
     using namespace featuremesh;
     const auto start = std::chrono::steady_clock::now();
     vtkImageData* image = vtkImageData::GetData(inputVector[0], 0);
-    vtkPointSet* objectSeeds = vtkPointSet::GetData(inputVector[1], 0);
-    vtkPointSet* backgroundSeeds = vtkPointSet::GetData(inputVector[2], 0);
+    vtkDataObject* objectSeeds = vtkDataObject::GetData(inputVector[1], 0);
+    vtkDataObject* backgroundSeeds = vtkDataObject::GetData(inputVector[2], 0);
     vtkImageData* output = vtkImageData::GetData(outputVector, 0);
     vtkPolyData* contourOutput = vtkPolyData::GetData(outputVector, 1);
     vtkPolyData* samplesOutput = vtkPolyData::GetData(outputVector, 2);

@@ -88,7 +88,7 @@ vtkSuperVoxelCut::vtkSuperVoxelCut()
 
 int vtkSuperVoxelCut::FillInputPortInformation(int port, vtkInformation* info)
 {
-  const char* types[5] = { "vtkUnstructuredGrid", "vtkPointSet", "vtkPointSet", "vtkImageData", "vtkDataObject" };
+  const char* types[5] = { "vtkUnstructuredGrid", "vtkDataObject", "vtkDataObject", "vtkImageData", "vtkDataObject" };
   info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), types[port]);
   if (port > 0)
   {
@@ -140,8 +140,8 @@ int vtkSuperVoxelCut::RequestData(
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
     vtkUnstructuredGrid* input = vtkUnstructuredGrid::GetData(inputVector[0], 0);
-    vtkPointSet* objectSeeds = vtkPointSet::GetData(inputVector[1], 0);
-    vtkPointSet* backgroundSeeds = vtkPointSet::GetData(inputVector[2], 0);
+    vtkDataObject* objectSeeds = vtkDataObject::GetData(inputVector[1], 0);
+    vtkDataObject* backgroundSeeds = vtkDataObject::GetData(inputVector[2], 0);
     vtkImageData* image = vtkImageData::GetData(inputVector[3], 0);
     vtkDataObject* labelledSeeds = vtkDataObject::GetData(inputVector[4], 0);
     vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);

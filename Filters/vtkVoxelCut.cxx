@@ -43,7 +43,7 @@ vtkVoxelCut::vtkVoxelCut()
 
 int vtkVoxelCut::FillInputPortInformation(int port, vtkInformation* info)
 {
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port == 0 ? "vtkImageData" : (port == 3 ? "vtkDataObject" : "vtkPointSet"));
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port == 0 ? "vtkImageData" : "vtkDataObject");
   if (port > 0)
   {
     info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
@@ -75,8 +75,8 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     using namespace featuremesh;
     const auto start = std::chrono::steady_clock::now();
     vtkImageData* image = vtkImageData::GetData(inputVector[0], 0);
-    vtkPointSet* objectSeeds = vtkPointSet::GetData(inputVector[1], 0);
-    vtkPointSet* backgroundSeeds = vtkPointSet::GetData(inputVector[2], 0);
+    vtkDataObject* objectSeeds = vtkDataObject::GetData(inputVector[1], 0);
+    vtkDataObject* backgroundSeeds = vtkDataObject::GetData(inputVector[2], 0);
     vtkDataObject* labelledSeeds = vtkDataObject::GetData(inputVector[3], 0);
     vtkImageData* output = vtkImageData::GetData(outputVector, 0);
     std::string error, warning;
