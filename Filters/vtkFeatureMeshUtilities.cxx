@@ -911,4 +911,25 @@ void AddLabelTable(vtkDataObject* object, int labels, const std::string& text)
   }
   object->GetFieldData()->AddArray(list);
 }
+
+void AddMultiLabelFields(vtkDataObject* object, const MultiLabelResult& result, const std::string& labelNames)
+{
+  AddLabelTable(object, result.Labels, labelNames);
+  AddFieldValue(object, names::Sigma, result.Sigma);
+  AddFieldValue(object, names::Energy, result.Energy);
+  AddFieldValue(object, names::ExpansionMoves, result.Moves);
+  AddFieldValue(object, names::ExpansionCycles, result.Cycles);
+  AddFieldValue(object, names::ExpansionSeconds, result.ExpansionSeconds);
+  AddFieldValue(object, names::GeodesicSeconds, result.GeodesicSeconds);
+}
+
+void SetLabelImage(vtkImageData* image, const ImageGeometry& geometry, const std::vector<std::uint8_t>& labels)
+{
+  SetImageFrame(image, geometry);
+  vtkNew<vtkUnsignedCharArray> array;
+  array->SetName(names::Label);
+  array->SetNumberOfTuples(geometry.Size());
+  std::copy(labels.begin(), labels.end(), array->GetPointer(0));
+  image->GetPointData()->SetScalars(array);
+}
 } // namespace featuremesh

@@ -35,6 +35,7 @@ class vtkUnstructuredGrid;
 namespace featuremesh
 {
 struct LabelledSeeds;
+struct MultiLabelResult;
 
 // Reports an exception that escaped a filter's body as its error (out of memory, or a library's
 // failure); returns 0.
@@ -221,6 +222,13 @@ void AddFieldValue(vtkDataObject* object, const char* name, double value);
 // Field data Labels (the count) and LabelNames (one string per label, from `names` split at ';',
 // empty where it gives none).
 void AddLabelTable(vtkDataObject* object, int labels, const std::string& names);
+
+// A multi-label cut's field data: the label table, Sigma, Energy, ExpansionMoves, ExpansionCycles,
+// ExpansionSeconds, GeodesicSeconds.
+void AddMultiLabelFields(vtkDataObject* object, const MultiLabelResult& result, const std::string& labelNames);
+
+// `image` in the frame of `geometry` with the uint8 point scalars Label (one per voxel).
+void SetLabelImage(vtkImageData* image, const ImageGeometry& geometry, const std::vector<std::uint8_t>& labels);
 
 // Adds the object components of a cut to the field data: ObjectComponents (their number),
 // ObjectComponentVolumes (world units, largest first) and ConnectivityChanged.

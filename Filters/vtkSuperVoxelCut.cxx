@@ -449,14 +449,8 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
   vtkImageData* labelImage = vtkImageData::GetData(outputVector, 2);
   for (vtkDataObject* d : { static_cast<vtkDataObject*>(output), static_cast<vtkDataObject*>(labelImage) })
   {
-    AddLabelTable(d, result.Labels, this->LabelNames);
-    AddFieldValue(d, names::Sigma, result.Sigma);
-    AddFieldValue(d, names::Energy, result.Energy);
-    AddFieldValue(d, names::ExpansionMoves, result.Moves);
-    AddFieldValue(d, names::ExpansionCycles, result.Cycles);
+    AddMultiLabelFields(d, result, this->LabelNames);
     AddFieldValue(d, names::SetupSeconds, result.SetupSeconds);
-    AddFieldValue(d, names::ExpansionSeconds, result.ExpansionSeconds);
-    AddFieldValue(d, names::GeodesicSeconds, result.GeodesicSeconds);
     AddFieldValue(d, names::CutTotalSeconds, std::chrono::duration<double>(Clock::now() - start).count());
   }
   this->UpdateProgress(1.0);

@@ -160,12 +160,7 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     {
       return fail(cut.Error);
     }
-    SetImageFrame(output, geometry);
-    vtkNew<vtkUnsignedCharArray> labels;
-    labels->SetName(names::Label);
-    labels->SetNumberOfTuples(geometry.Size());
-    std::copy(cut.Label.begin(), cut.Label.end(), labels->GetPointer(0));
-    output->GetPointData()->SetScalars(labels);
+    SetLabelImage(output, geometry, cut.Label);
     AddFieldValue(output, names::Sigma, cut.Sigma);
     AddFieldValue(output, names::Bins, cut.Bins);
     AddFieldValue(output, names::Flow, cut.Flow);
@@ -218,19 +213,8 @@ int vtkVoxelCut::RequestMultiLabel(const featuremesh::LabelledSeeds& seeds, vtkD
     return 0;
   }
   vtkImageData* output = vtkImageData::GetData(outputVector, 0);
-  SetImageFrame(output, geometry);
-  vtkNew<vtkUnsignedCharArray> labels;
-  labels->SetName(names::Label);
-  labels->SetNumberOfTuples(n);
-  std::copy(result.Label.begin(), result.Label.end(), labels->GetPointer(0));
-  output->GetPointData()->SetScalars(labels);
-  AddLabelTable(output, result.Labels, this->LabelNames);
-  AddFieldValue(output, names::Sigma, result.Sigma);
-  AddFieldValue(output, names::Energy, result.Energy);
-  AddFieldValue(output, names::ExpansionMoves, result.Moves);
-  AddFieldValue(output, names::ExpansionCycles, result.Cycles);
-  AddFieldValue(output, names::ExpansionSeconds, result.ExpansionSeconds);
-  AddFieldValue(output, names::GeodesicSeconds, result.GeodesicSeconds);
+  SetLabelImage(output, geometry, result.Label);
+  AddMultiLabelFields(output, result, this->LabelNames);
   AddFieldValue(output, names::TotalSeconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   this->UpdateProgress(1.0);
   return 1;
