@@ -800,6 +800,61 @@ ElementStatistics ImageElementStatistics(const ElementRasterizer& raster, vtkDat
   return none;
 }
 
+vtkSmartPointer<vtkImageData> VoxelValuedImage(vtkImageData* image, vtkInformation* arrayInfo)
+{
+  if (!image)
+  {
+    return nullptr;
+  }
+  vtkCellData* cells = image->GetCellData();
+  // A cell array named by the selection; pvpython can carry a selection over from another source.
+  const bool cellChosen = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_ASSOCIATION()) &&
+    arrayInfo->Get(vtkDataObject::FIELD_ASSOCIATION()) == vtkDataObject::FIELD_ASSOCIATION_CELLS &&
+    arrayInfo->Has(vtkDataObject::FIELD_NAME()) && cells->GetArray(arrayInfo->Get(vtkDataObject::FIELD_NAME()));
+  const bool onlyCells = image->GetPointData()->GetNumberOfArrays() == 0 && cells->GetNumberOfArrays() > 0;
+  if (!(cellChosen || onlyCells) || image->GetNumberOfCells() == 0)
+  {
+    return image;
+  }
+  int extent[6];
+  image->GetExtent(extent);
+  double half[3] = { 0.0, 0.0, 0.0 };
+  for (int a = 0; a < 3; ++a)
+  {
+    if (extent[2 * a + 1] > extent[2 * a])
+    {
+      extent[2 * a + 1] -= 1;
+      half[a] = 0.5;
+    }
+  }
+  // The first cell's centre in world coordinates, through the direction matrix.
+  double firstCentre[3];
+  image->TransformContinuousIndexToPhysicalPoint(
+    extent[0] + half[0], extent[2] + half[1], extent[4] + half[2], firstCentre);
+  vtkNew<vtkImageData> voxels;
+  voxels->SetExtent(extent);
+  voxels->SetSpacing(image->GetSpacing());
+  voxels->SetDirectionMatrix(image->GetDirectionMatrix());
+  double origin[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    origin[a] = image->GetOrigin()[a];
+  }
+  // Shift the origin so that index `extent[0..]` lands on the first cell's centre.
+  double atFirst[3];
+  voxels->SetOrigin(origin);
+  voxels->TransformIndexToPhysicalPoint(extent[0], extent[2], extent[4], atFirst);
+  for (int a = 0; a < 3; ++a)
+  {
+    origin[a] += firstCentre[a] - atFirst[a];
+  }
+  voxels->SetOrigin(origin);
+  voxels->GetPointData()->ShallowCopy(cells);
+  voxels->GetPointData()->RemoveArray(vtkDataSetAttributes::GhostArrayName());
+  voxels->GetFieldData()->ShallowCopy(image->GetFieldData());
+  return voxels;
+}
+
 vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::string& error, std::string& warning)
 {
   const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME()) ? arrayInfo->Get(vtkDataObject::FIELD_NAME()) : nullptr;

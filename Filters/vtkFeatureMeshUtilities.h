@@ -201,6 +201,12 @@ bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error
 // Null with `error` set when the array is unusable (components, type, NaN/Inf).
 const float* FloatValues(vtkDataArray* array, std::vector<float>& storage, std::string& error);
 
+// The image as the filters read it: values on voxel centres (point data). An image whose values
+// are cell data (each cell a voxel, as ParaView's GDAL reader gives a PNG or TIFF) becomes the image
+// of its cell centres carrying those values; so does one whose chosen array (`arrayInfo`) is a cell
+// array. Any other image is returned as it is. Null stays null.
+vtkSmartPointer<vtkImageData> VoxelValuedImage(vtkImageData* image, vtkInformation* arrayInfo);
+
 // The image point array named by SetInputArrayToProcess (looked up on `image`, whatever port the
 // selection names), or the active point scalars when no name was given (ParaView sends an empty
 // name when the input had not run yet). A missing named array falls back to the active scalars with

@@ -99,7 +99,8 @@ int vtkFeatureNodes::Execute(vtkInformationVector** inputVector, vtkInformationV
   using namespace featuremesh;
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  vtkImageData* input = vtkImageData::GetData(inputVector[0], 0);
+  vtkSmartPointer<vtkImageData> input =
+    VoxelValuedImage(vtkImageData::GetData(inputVector[0], 0), this->GetInputArrayInformation(0));
   vtkImageData* edgeInput = vtkImageData::GetData(inputVector[1], 0);
   vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
   vtkImageData* edgeOutput = vtkImageData::GetData(outputVector, 1);

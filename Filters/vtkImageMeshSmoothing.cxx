@@ -62,7 +62,8 @@ int vtkImageMeshSmoothing::RequestData(
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
     vtkUnstructuredGrid* input = vtkUnstructuredGrid::GetData(inputVector[0], 0);
-    vtkImageData* image = vtkImageData::GetData(inputVector[1], 0);
+    vtkSmartPointer<vtkImageData> image =
+      VoxelValuedImage(vtkImageData::GetData(inputVector[1], 0), this->GetInputArrayInformation(0));
     vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
     std::string error, warning;
     auto fail = [&](const std::string& why) {

@@ -91,7 +91,8 @@ int vtkRSPEdgeEnhancement::RequestData(vtkInformation*, vtkInformationVector** i
   return featuremesh::RunFilter(this, "RSP Edge Enhancement", outputVector, this->FailedAt, this->FailedAtTime, [&]() -> int {
     using namespace featuremesh;
     const auto start = std::chrono::steady_clock::now();
-    vtkImageData* image = vtkImageData::GetData(inputVector[0], 0);
+    vtkSmartPointer<vtkImageData> image =
+      VoxelValuedImage(vtkImageData::GetData(inputVector[0], 0), this->GetInputArrayInformation(0));
     vtkDataObject* objectSeeds = vtkDataObject::GetData(inputVector[1], 0);
     vtkDataObject* backgroundSeeds = vtkDataObject::GetData(inputVector[2], 0);
     vtkImageData* output = vtkImageData::GetData(outputVector, 0);

@@ -142,7 +142,8 @@ int vtkSuperVoxelCut::RequestData(
     vtkUnstructuredGrid* input = vtkUnstructuredGrid::GetData(inputVector[0], 0);
     vtkDataObject* objectSeeds = vtkDataObject::GetData(inputVector[1], 0);
     vtkDataObject* backgroundSeeds = vtkDataObject::GetData(inputVector[2], 0);
-    vtkImageData* image = vtkImageData::GetData(inputVector[3], 0);
+    vtkSmartPointer<vtkImageData> image =
+      VoxelValuedImage(vtkImageData::GetData(inputVector[3], 0), this->GetInputArrayInformation(0));
     vtkDataObject* labelledSeeds = vtkDataObject::GetData(inputVector[4], 0);
     vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
     vtkImageData* labelImage = vtkImageData::GetData(outputVector, 2);

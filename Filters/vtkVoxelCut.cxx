@@ -74,7 +74,8 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
   return featuremesh::RunFilter(this, "Voxel Cut", outputVector, this->FailedAt, this->FailedAtTime, [&]() -> int {
     using namespace featuremesh;
     const auto start = std::chrono::steady_clock::now();
-    vtkImageData* image = vtkImageData::GetData(inputVector[0], 0);
+    vtkSmartPointer<vtkImageData> image =
+      VoxelValuedImage(vtkImageData::GetData(inputVector[0], 0), this->GetInputArrayInformation(0));
     vtkDataObject* objectSeeds = vtkDataObject::GetData(inputVector[1], 0);
     vtkDataObject* backgroundSeeds = vtkDataObject::GetData(inputVector[2], 0);
     vtkDataObject* labelledSeeds = vtkDataObject::GetData(inputVector[3], 0);

@@ -97,7 +97,7 @@ def open_image(path):
     direction matrix that ITK and MetaImage use, so that the world coordinates of a case's seeds mean
     the same voxels in its .mha and in its .nii. Channels (a fourth axis) become components."""
     if not path.lower().endswith(NIFTI_SUFFIXES):
-        return ps.OpenDataFile(path)
+        return voxel_valued(ps.OpenDataFile(path))
     import nibabel
     from vtkmodules.util.numpy_support import numpy_to_vtk
     from vtkmodules.vtkCommonDataModel import vtkImageData
@@ -122,6 +122,40 @@ def open_image(path):
     source.GetClientSideObject().SetOutput(image)
     source.UpdatePipeline()
     return source
+
+
+def voxel_valued(source):
+    """`source`, or, when its image carries its values as cell data (ParaView's GDAL reader gives a
+    PNG or TIFF so, each cell a pixel), a source of the image of its cell centres with those values
+    as point data: what the filters do with such an image (VoxelValuedImage), made once so that the
+    script's views, truth and Dice read point data."""
+    source.UpdatePipeline()
+    if source.PointData.keys() or not source.CellData.keys():
+        return source
+    from vtkmodules.vtkCommonDataModel import vtkDataSetAttributes, vtkImageData
+    cells = fetch(source)
+    extent = list(cells.GetExtent())
+    half = [0.0, 0.0, 0.0]
+    for a in range(3):
+        if extent[2 * a + 1] > extent[2 * a]:
+            extent[2 * a + 1] -= 1
+            half[a] = 0.5
+    image = vtkImageData()
+    image.SetExtent(extent)
+    image.SetSpacing(cells.GetSpacing())
+    image.SetDirectionMatrix(cells.GetDirectionMatrix())
+    first = [0.0, 0.0, 0.0]
+    cells.TransformContinuousIndexToPhysicalPoint(*[extent[2 * a] + half[a] for a in range(3)], first)
+    image.SetOrigin(cells.GetOrigin())
+    at = [0.0, 0.0, 0.0]
+    image.TransformIndexToPhysicalPoint(extent[0], extent[2], extent[4], at)
+    image.SetOrigin(*[o + f - t for o, f, t in zip(cells.GetOrigin(), first, at)])
+    image.GetPointData().ShallowCopy(cells.GetCellData())
+    image.GetPointData().RemoveArray(vtkDataSetAttributes.GhostArrayName())
+    producer = ps.TrivialProducer()
+    producer.GetClientSideObject().SetOutput(image)
+    producer.UpdatePipeline()
+    return producer
 
 
 def fetch(proxy, port=0):
