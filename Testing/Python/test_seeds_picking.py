@@ -33,9 +33,8 @@ def picked(csv):
         x, y, _ = (int(round(v)) for v in renderer.GetDisplayPoint())
         ps.SetActiveSource(case.image)
         ps.SelectSurfacePoints(Rectangle=[x, y, x, y], View=view, Modifier=None if i == 0 else "ADD")
-    extracted = ps.ExtractSelection(Input=case.image)
-    # Freeze the selection: the next kind's clicks replace it.
-    frozen = ps.PassArrays(Input=extracted)
+    # Extract Selection keeps its copy of the selection when the next kind's clicks replace it.
+    frozen = ps.ExtractSelection(Input=case.image)
     points = ft.fetch(frozen)
     got = np.array([points.GetPoint(i) for i in range(points.GetNumberOfPoints())])
     return frozen, aimed, got
