@@ -70,6 +70,7 @@ int vtkDelaunayImageMesh::RequestData(
     vtkSmartPointer<vtkImageData> image =
       VoxelValuedImage(vtkImageData::GetData(inputVector[1], 0), this->GetInputArrayInformation(0));
     vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
+    DropVoxelOwners(output); // the last run's map, which the executive's reset leaves on the object
     std::string error, warning;
     ImageGeometry geometry;
     if (IsEmptyPiece(outputVector, nodes) || IsEmptyPiece(outputVector, image))

@@ -16,6 +16,7 @@
 #include "vtkPoints.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkUnstructuredGrid.h"
+#include "vtkWeakPointer.h"
 #include "vtkDataArray.h"
 #include "vtkDataObject.h"
 #include "vtkDataSet.h"
@@ -26,6 +27,7 @@
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationIntegerRequestKey.h"
+#include "vtkInformationObjectBaseKey.h"
 #include "vtkInformationVector.h"
 #include "vtkDemandDrivenPipeline.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
@@ -37,6 +39,7 @@
 #include "vtkTypeUInt64Array.h"
 
 #include <algorithm>
+#include <mutex>
 
 #include <cmath>
 #include <cstdlib>
@@ -695,17 +698,47 @@ std::uint64_t MeshDigest(vtkUnstructuredGrid* grid)
   return h;
 }
 
+namespace
+{
+// The owner map is not on the data object's arrays, which writers save (4 bytes per voxel): the
+// producer's output keeps it in its information, which no writer saves, and a registry finds it
+// by the digest of the points and cells it was made for. The consumer's input is a shallow copy
+// (ParaView puts a pass-through filter on every port), which shares the points and cells but not
+// the information.
+vtkInformationObjectBaseKey* OwnerMapKey()
+{
+  static vtkInformationObjectBaseKey* const key =
+    new vtkInformationObjectBaseKey("VOXEL_OWNERS", "FeatureMesh", "vtkIntArray"); // VTK's key manager deletes it
+  return key;
+}
+
+struct OwnerMapEntry
+{
+  std::uint64_t Digest;
+  vtkWeakPointer<vtkIntArray> Map; // expires with the producer's output
+};
+
+std::mutex OwnerMapsMutex;
+std::vector<OwnerMapEntry>& OwnerMaps()
+{
+  static std::vector<OwnerMapEntry> maps;
+  return maps;
+}
+} // namespace
+
 void AttachVoxelOwners(vtkUnstructuredGrid* mesh, vtkIntArray* owner)
 {
+  DropVoxelOwners(mesh);
   if (!owner)
   {
     return;
   }
-  mesh->GetFieldData()->AddArray(owner);
-  vtkNew<vtkTypeUInt64Array> digest;
-  digest->SetName(names::VoxelOwnerDigest);
-  digest->InsertNextValue(MeshDigest(mesh));
-  mesh->GetFieldData()->AddArray(digest);
+  mesh->GetInformation()->Set(OwnerMapKey(), owner);
+  const std::uint64_t digest = MeshDigest(mesh);
+  std::lock_guard<std::mutex> lock(OwnerMapsMutex);
+  auto& maps = OwnerMaps();
+  maps.erase(std::remove_if(maps.begin(), maps.end(), [](const OwnerMapEntry& e) { return !e.Map; }), maps.end());
+  maps.push_back({ digest, owner });
 }
 
 namespace
@@ -752,16 +785,25 @@ void StopVoxelOwnersRequest(vtkInformationVector* portVector)
 
 void DropVoxelOwners(vtkDataObject* object)
 {
-  object->GetFieldData()->RemoveArray(names::VoxelOwner);
-  object->GetFieldData()->RemoveArray(names::VoxelOwnerDigest);
+  object->GetInformation()->Remove(OwnerMapKey());
 }
 
 bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, VoxelOwnerMap& owner)
 {
-  vtkIntArray* array = vtkIntArray::SafeDownCast(mesh->GetFieldData()->GetAbstractArray(names::VoxelOwner));
-  vtkTypeUInt64Array* digest = vtkTypeUInt64Array::SafeDownCast(mesh->GetFieldData()->GetAbstractArray(names::VoxelOwnerDigest));
-  if (!array || !digest || array->GetNumberOfComponents() != 1 || array->GetNumberOfTuples() != voxels ||
-    digest->GetNumberOfTuples() != 1 || digest->GetValue(0) != MeshDigest(mesh))
+  vtkSmartPointer<vtkIntArray> array;
+  {
+    const std::uint64_t digest = MeshDigest(mesh);
+    std::lock_guard<std::mutex> lock(OwnerMapsMutex);
+    for (const OwnerMapEntry& e : OwnerMaps())
+    {
+      vtkSmartPointer<vtkIntArray> map = e.Map.GetPointer();
+      if (e.Digest == digest && map && map->GetNumberOfComponents() == 1 && map->GetNumberOfTuples() == voxels)
+      {
+        array = map;
+      }
+    }
+  }
+  if (!array)
   {
     return false;
   }

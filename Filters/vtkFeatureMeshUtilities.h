@@ -151,12 +151,12 @@ void WriteImageMesh(const SimplexMesh& mesh, const ElementStatistics& statistics
 
 // The owner map of stages 2 and 3 (Contract.h, VoxelOwner): a fresh array of `voxels` tuples to fill
 // (ComputeElementStatistics), or null when the consumers of `outputVector`'s port 0 asked for none
-// (VoxelOwnersRequest); attached (when not null) to the written mesh with the digest of its points
-// and cells.
+// (VoxelOwnersRequest); kept (when not null) in the written mesh's information and registered
+// under the digest of its points and cells, off the arrays that writers save.
 vtkSmartPointer<vtkIntArray> NewVoxelOwnerArray(vtkInformationVector* outputVector, std::int64_t voxels);
 void AttachVoxelOwners(vtkUnstructuredGrid* mesh, vtkIntArray* owner);
-// The owner map attached to `mesh` when it has `voxels` tuples and was made for the mesh's points and
-// cells as they are now; else false (the caller rasterises).
+// The owner map registered for `mesh`'s points and cells as they are now (any shallow copy of the
+// mesh a stage wrote) when it has `voxels` tuples; else false (the caller rasterises).
 // `owner` views the array (no copy) and keeps it alive.
 bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, VoxelOwnerMap& owner);
 // The request a consumer makes of a mesh's owner map, on the mesh's output information: 0 = none
@@ -170,7 +170,7 @@ vtkInformationIntegerRequestKey* VoxelOwnersRequest();
 void RequestNoVoxelOwners(vtkInformationVector* portVector);
 // Removes the request from every input connected to `port` (called in RequestUpdateExtent).
 void StopVoxelOwnersRequest(vtkInformationVector* portVector);
-// Removes the owner map from a copy that is no longer an image mesh (a labelled mesh, a moved one).
+// Releases the owner map kept in `object`'s information (a stage's output before it runs again).
 void DropVoxelOwners(vtkDataObject* object);
 // A 64-bit digest of a grid's points and cells as stored.
 std::uint64_t MeshDigest(vtkUnstructuredGrid* grid);

@@ -47,6 +47,8 @@ struct vtkSuperVoxelCut::MeshData
   featuremesh::NodeBinRuns Runs;
   std::vector<double> ChannelMean, ChannelCount;
   featuremesh::MultiLabelCache Multi;
+  // Whether the voxel owners came from the mesh's own map (stage 2 or 3) instead of a rasterisation.
+  bool OwnerMapReused = false;
 
   MeshData(std::initializer_list<vtkObject*> sources, const featuremesh::ImageGeometry& frame)
     : Frame(frame)
@@ -258,7 +260,7 @@ int vtkSuperVoxelCut::RequestData(
       std::string ignored;
       if (ImageGeometryFromFieldData(input, meshFrame, ignored) && SameFrame(meshFrame, geometry))
       {
-        AttachedVoxelOwners(input, geometry.Size(), prepared->Cut.Owner);
+        prepared->OwnerMapReused = AttachedVoxelOwners(input, geometry.Size(), prepared->Cut.Owner);
       }
       const ProgressFunction progress = AlgorithmProgress(this, 0.1, 0.4);
       bool ready = false;
@@ -339,6 +341,7 @@ int vtkSuperVoxelCut::RequestData(
       AddFieldValue(d, names::ObjectElements, static_cast<double>(objectElements));
       AddObjectComponents(d, cut.ObjectComponentVoxels, geometry.VoxelVolume(), cut.ConnectivityChanged);
       AddFieldValue(d, names::SetupSeconds, result.SetupSeconds);
+      AddFieldValue(d, names::OwnerMapReused, this->Prepared->OwnerMapReused ? 1.0 : 0.0);
       AddFieldValue(d, names::GraphSeconds, cut.GraphSeconds);
       AddFieldValue(d, names::FlowSeconds, cut.FlowSeconds);
       AddFieldValue(d, names::GeodesicSeconds, cut.GeodesicSeconds);
@@ -452,6 +455,7 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
   {
     AddMultiLabelFields(d, result, this->LabelNames);
     AddFieldValue(d, names::SetupSeconds, result.SetupSeconds);
+    AddFieldValue(d, names::OwnerMapReused, this->Prepared->OwnerMapReused ? 1.0 : 0.0);
     AddFieldValue(d, names::CutTotalSeconds, std::chrono::duration<double>(Clock::now() - start).count());
   }
   this->UpdateProgress(1.0);

@@ -37,9 +37,9 @@ def cell_array(data, names):
     raise KeyError(names)
 
 
-def owners(data):
-    """The voxel -> element map a mesh carries (field array VoxelOwner), or "none"."""
-    a = data.GetFieldData().GetArray("VoxelOwner")
+def owners(proxy):
+    """The voxel -> element map a mesh proxy keeps (fm.owner_map), or "none"."""
+    a = fm.owner_map(proxy)
     return sha(fm.v2n(a)) if a is not None else "none"
 
 
@@ -64,7 +64,7 @@ def main():
             tag = "%s/%s" % (name, "CGAL" if backend else "default")
             lines.append("%s mesh %s" % (tag, sha(fm.v2n(m.GetPoints().GetData()), fm.v2n(m.GetCells().GetConnectivityArray()),
                                                   *[cell_array(m, a) for a in CELL_ARRAYS])))
-            lines.append("%s mesh owners %s" % (tag, owners(m)))
+            lines.append("%s mesh owners %s" % (tag, owners(mesh)))
             cut = case.super_voxel_cut(mesh, **cut_properties)
             lines.append("%s labels %s" % (tag, sha(fm.v2n(fm.fetch(cut, 0).GetCellData().GetArray("Label")),
                                                     fm.v2n(fm.fetch(cut, 2).GetPointData().GetScalars()))))
@@ -77,7 +77,7 @@ def main():
                 s = fm.fetch(smoothed)
                 lines.append("%s smoothed %s" % (tag, sha(fm.v2n(s.GetPoints().GetData()), fm.v2n(s.GetCells().GetConnectivityArray()),
                                                           *[cell_array(s, a) for a in CELL_ARRAYS])))
-                lines.append("%s smoothed owners %s" % (tag, owners(s)))
+                lines.append("%s smoothed owners %s" % (tag, owners(smoothed)))
         lines.append("%s voxelcut %s" % (name, sha(fm.v2n(fm.fetch(case.voxel_cut(**cut_properties)).GetPointData().GetScalars()))))
         print(lines[-1], flush=True)
     text = "\n".join(lines) + "\n"

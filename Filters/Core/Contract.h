@@ -51,11 +51,13 @@ constexpr const char* ImageOrigin = "ImageOrigin";
 constexpr const char* ImageSpacing = "ImageSpacing";
 constexpr const char* ImageDimensions = "ImageDimensions";
 constexpr const char* ImageDirection = "ImageDirection";
-// Field data of the image mesh (stages 2, 3): the element owning each voxel centre (int32, one
-// tuple per voxel of the frame in raster order, -1 none) and a digest of the points and cells it
-// was made for; the cut reuses it instead of rasterising again while the mesh is unchanged.
+// The image mesh's owner map (stages 2, 3): the element owning each voxel centre (int32, one tuple
+// per voxel of the frame in raster order, -1 none), kept in the mesh's information (key
+// FeatureMesh.VOXEL_OWNERS, with FeatureMesh.VOXEL_OWNERS_DIGEST of the points and cells it was
+// made for), so that writers do not save it; the cut reuses it instead of rasterising again while
+// the mesh is unchanged and says so in OwnerMapReused (field data, 1 or 0).
 constexpr const char* VoxelOwner = "VoxelOwner";
-constexpr const char* VoxelOwnerDigest = "VoxelOwnerDigest";
+constexpr const char* OwnerMapReused = "OwnerMapReused";
 // Field data: summaries.
 constexpr const char* NodeCounts = "NodeCounts";   // stage 1, per type
 constexpr const char* StepSeconds = "StepSeconds"; // stage 1, per step

@@ -158,6 +158,23 @@ def voxel_valued(source):
     return producer
 
 
+def owner_map(proxy, port=0):
+    """The voxel -> element map (vtkIntArray) a stage 2 or 3 proxy keeps on its output's information
+    (key FeatureMesh.VOXEL_OWNERS), or None. Writers and Fetch leave it behind, so this reads the
+    output object itself: builtin sessions (pvpython, the tests) only."""
+    from vtkmodules.vtkCommonCore import vtkInformationIterator
+    info = proxy.GetClientSideObject().GetOutputDataObject(port).GetInformation()
+    keys = vtkInformationIterator()
+    keys.SetInformation(info)
+    keys.InitTraversal()
+    while not keys.IsDoneWithTraversal():
+        key = keys.GetCurrentKey()
+        if key.GetLocation() == "FeatureMesh" and key.GetName() == "VOXEL_OWNERS":
+            return info.Get(key)
+        keys.GoToNextItem()
+    return None
+
+
 def fetch(proxy, port=0):
     return sm.Fetch(proxy, idx=port)
 
