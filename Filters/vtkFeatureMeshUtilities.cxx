@@ -523,6 +523,34 @@ void PassNodeArrays(vtkPointData* in, vtkIdType nIn, vtkPointData* out, vtkIdTyp
   out->SetActiveAttribute(-1, vtkDataSetAttributes::SCALARS);
 }
 
+void PutContractVersionFirst(vtkInformationVector* outputVector)
+{
+  for (int port = 0; port < outputVector->GetNumberOfInformationObjects(); ++port)
+  {
+    vtkDataObject* object = outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT());
+    vtkFieldData* fields = object ? object->GetFieldData() : nullptr;
+    if (!fields || (fields->GetNumberOfArrays() > 0 && fields->GetAbstractArray(0)->GetName() &&
+                     std::string(fields->GetAbstractArray(0)->GetName()) == names::ContractVersion))
+    {
+      continue;
+    }
+    vtkNew<vtkFieldData> ordered;
+    vtkNew<vtkUnsignedCharArray> version;
+    version->SetName(names::ContractVersion);
+    version->InsertNextValue(ContractVersionNumber);
+    ordered->AddArray(version);
+    for (int i = 0; i < fields->GetNumberOfArrays(); ++i)
+    {
+      vtkAbstractArray* a = fields->GetAbstractArray(i);
+      if (!(a->GetName() && std::string(a->GetName()) == names::ContractVersion))
+      {
+        ordered->AddArray(a);
+      }
+    }
+    object->SetFieldData(ordered);
+  }
+}
+
 void RequestWholeImage(vtkInformationVector* portVector)
 {
   for (int c = 0; c < portVector->GetNumberOfInformationObjects(); ++c)
@@ -991,9 +1019,11 @@ namespace featuremesh
 void AddLabelTable(vtkDataObject* object, int labels, const std::string& text)
 {
   AddFieldValue(object, names::Labels, labels);
-  vtkNew<vtkStringArray> list;
+  // Numbers named by their components, not strings: meshio reads no string arrays.
+  vtkNew<vtkUnsignedCharArray> list;
   list->SetName(names::LabelNames);
-  list->SetNumberOfValues(labels);
+  list->SetNumberOfComponents(labels);
+  list->SetNumberOfTuples(1);
   std::size_t from = 0;
   for (int l = 0; l < labels; ++l)
   {
@@ -1004,7 +1034,8 @@ void AddLabelTable(vtkDataObject* object, int labels, const std::string& text)
       name = text.substr(from, end - from);
       from = end + 1;
     }
-    list->SetValue(l, name);
+    list->SetComponentName(l, name.c_str());
+    list->SetComponent(0, l, l);
   }
   object->GetFieldData()->AddArray(list);
 }

@@ -54,6 +54,9 @@ struct RunState
 };
 RunState PipelineState(vtkAlgorithm* algorithm, vtkInformationVector* outputVector);
 
+// Puts the field array ContractVersion (Contract.h) first in the field data of every output.
+void PutContractVersionFirst(vtkInformationVector* outputVector);
+
 // Runs a filter's body (returning int): on the STDThread SMP backend when VTK runs its Sequential
 // default and the user chose none with VTK_SMP_BACKEND_IN_USE (the host's backend is left as it
 // was), and with every exception caught at the VTK boundary. A failure is not run (and reported)
@@ -83,6 +86,10 @@ int RunFilter(vtkAlgorithm* algorithm, const char* filter, vtkInformationVector*
   catch (...)
   {
     result = ReportException(algorithm, filter, std::current_exception());
+  }
+  if (result)
+  {
+    PutContractVersionFirst(outputVector);
   }
   failedAt = result ? 0 : state.Modified;
   failedAtTime = state.TimeStep;
@@ -225,8 +232,8 @@ void BoundaryPolyData(vtkPoints* points, const std::vector<std::int64_t>& faces,
 // Adds a one-value double array `name` to the object's field data (summaries, timings).
 void AddFieldValue(vtkDataObject* object, const char* name, double value);
 
-// Field data Labels (the count) and LabelNames (one string per label, from `names` split at ';',
-// empty where it gives none).
+// Field data Labels (the count) and LabelNames (uint8, one tuple of the label values 0..k whose
+// component names are the labels' names, from `names` split at ';', empty where it gives none).
 void AddLabelTable(vtkDataObject* object, int labels, const std::string& names);
 
 // A multi-label cut's field data: the label table, Sigma, Energy, ExpansionMoves, ExpansionCycles,

@@ -20,6 +20,9 @@ enum class NodeType : std::uint8_t
 constexpr std::uint8_t LabelBackground = 0;
 constexpr std::uint8_t LabelObject = 1;
 
+// The value of the ContractVersion field array (docs/CONTRACT.md).
+constexpr std::uint8_t ContractVersionNumber = 1;
+
 namespace names
 {
 // Point arrays of nodes and mesh points.
@@ -47,6 +50,12 @@ constexpr const char* ContourRegion = "ContourRegion";           // uint8, 1 = e
 constexpr const char* SampleRole = "SampleRole";                 // uint8
 
 // Field data: the image frame a mesh was made on (3, 3, 3 and 9 components; direction row-major).
+// The first field array of every output: the contract's version (uint8, one value). One byte long,
+// it also makes the raw offsets of the field arrays after it odd in a .vtu that ParaView saves
+// (raw appended data): meshio re-encodes raw blocks to base64 (offsets multiples of 4) and finds
+// each block's array by its offset, so an even raw offset equal to an earlier array's new offset
+// loses that array (a meshio bug; Testing/Python/test_meshio_saved.py replays it).
+constexpr const char* ContractVersion = "ContractVersion";
 constexpr const char* ImageOrigin = "ImageOrigin";
 constexpr const char* ImageSpacing = "ImageSpacing";
 constexpr const char* ImageDimensions = "ImageDimensions";

@@ -38,6 +38,18 @@ try:
             lines.append("%s: %s is enabled with %s selected" % ("ok" if ok else "FAIL", filter_name, what))
         lines.append(("ok" if enabled("DelaunayImageMesh", image) is False else "FAIL") +
                      ": DelaunayImageMesh is not enabled with only the image selected")
+        # An image whose values are cell data (as the GDAL reader gives a PNG) enables Feature Nodes.
+        cell_image = ps.PointDatatoCellData(Input=image)
+        cell_image.UpdatePipeline()
+        lines.append("%s: FeatureNodes is enabled with a cell-data image selected" % ("ok" if enabled("FeatureNodes", cell_image) else "FAIL"))
+        # The cut after Apply in the GUI's render view: its labelled mesh with edges, coloured by Label.
+        cut = SuperVoxelCut(Mesh=mesh, ObjectSeeds=ps.PolyPointSource(Points=[24, 24, 0]),  # noqa: F821
+                            BackgroundSeeds=ps.PolyPointSource(Points=[2, 2, 0, 45, 45, 0]), Image=image)
+        cut.UpdatePipeline()
+        shown = ps.Show(cut, ps.GetActiveViewOrCreate("RenderView"))
+        ok = shown.Representation == "Surface With Edges" and list(shown.ColorArrayName) == ["CELLS", "Label"]
+        lines.append("%s: the cut shows Surface With Edges coloured by Label (%s, %s)" % ("ok" if ok else "FAIL", shown.Representation,
+                                                                                         list(shown.ColorArrayName)))
         cells = sm.Fetch(mesh).GetNumberOfCells()
         lines.append(("ok: the GUI session meshes the image (%d triangles)" if cells > 0 else "FAIL: no mesh (%d cells)") % cells)
 except Exception:

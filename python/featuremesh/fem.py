@@ -66,7 +66,7 @@ def label_names(grid, labels):
     binary = labels.max(initial=0) <= 1
     names = {}
     for L in (int(x) for x in np.unique(labels)):
-        name = given.GetValue(L) if given is not None and L < given.GetNumberOfValues() else ""
+        name = (given.GetComponentName(L) or "") if given is not None and L < given.GetNumberOfComponents() else ""
         names[L] = name or (REGION_NAMES[L] if binary or L == 0 else "label_%d" % L)
     return names
 
