@@ -185,6 +185,7 @@ int vtkImageMeshSmoothing::RequestData(
     AddFieldValue(output, names::EdgeFlips, static_cast<double>(result.Flips));
     AddFieldValue(output, names::SliverMoves, static_cast<double>(result.Perturbed));
     AddFieldValue(output, names::AddedNodes, static_cast<double>(result.AddedNodes));
+    AddFieldValue(output, names::SnappedNodes, static_cast<double>(result.SnappedNodes));
     AddFieldValue(output, names::SmoothingSeconds, smoothingSeconds);
     AddFieldValue(output, names::SweepSeconds, result.SweepSeconds);
     AddFieldValue(output, names::RefinementSeconds, result.RefinementSeconds);

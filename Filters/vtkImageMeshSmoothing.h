@@ -8,8 +8,9 @@
  * (multicolour Gauss-Seidel) to its CVT or ODT position under a density that grows with the image
  * gradient, then restores the Delaunay property (2D edge flips, 3D re-tetrahedralisation);
  * Delaunay refinement then adds nodes where the angle bounds are missed (2D CGAL, 3D TetGen with
- * the box faces kept), and 3D meshes finish with sliver perturbation. Fixed nodes (point array Fixed = 1) never move; free
- * nodes on the image box slide in their face or edge; box corners stay. The output has the same
+ * the box faces kept), and 3D meshes finish with sliver perturbation. Fixed nodes (point array
+ * Fixed = 1) never move (3D: within 1.5 voxels of the box they move onto it before refinement);
+ * free nodes on the image box slide in their face or edge; box corners stay. The output has the same
  * points (moved) and point arrays, new elements, and stage 2's cell arrays recomputed exactly, with
  * its own voxel owner map; it asks its input for none (docs/CONTRACT.md).
  * See Filters/Core/MeshSmoothing.h.

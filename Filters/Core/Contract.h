@@ -74,6 +74,7 @@ constexpr const char* NoiseSigma = "NoiseSigma";   // stage 1, the image noise's
 constexpr const char* NumberOfNodes = "NumberOfNodes";
 constexpr const char* NumberOfElements = "NumberOfElements";
 constexpr const char* AddedNodes = "AddedNodes";
+constexpr const char* SnappedNodes = "SnappedNodes"; // stage 3, 3D: nodes moved onto the image box
 constexpr const char* MaxOfMinAngles = "MaxOfMinAngles";
 constexpr const char* MaxOfMinDihedralAngles = "MaxOfMinDihedralAngles";
 constexpr const char* DelaunayBackend = "DelaunayBackend"; // 0 TetGen, 1 CGAL (2D is always CGAL)

@@ -86,6 +86,7 @@ struct MeshSmoothingResult
   std::int64_t Flips = 0;      // 2D edge flips (3D: tetrahedra changed by re-tetrahedralising)
   std::int64_t Perturbed = 0;  // 3D sliver-removal moves
   std::int64_t AddedNodes = 0; // by quality refinement; they follow the input's points
+  std::int64_t SnappedNodes = 0; // 3D: moved onto the image box before refinement
   // Seconds: sweeps (with the density image and the flips / re-tetrahedralisation), refinement, slivers.
   double SweepSeconds = 0, RefinementSeconds = 0, SliverSeconds = 0;
   bool Aborted = false;
