@@ -47,9 +47,20 @@ try:
                             BackgroundSeeds=ps.PolyPointSource(Points=[2, 2, 0, 45, 45, 0]), Image=image)
         cut.UpdatePipeline()
         shown = ps.Show(cut, ps.GetActiveViewOrCreate("RenderView"))
-        ok = shown.Representation == "Surface With Edges" and list(shown.ColorArrayName) == ["CELLS", "Label"]
+        ok = shown.Representation == "Surface With Edges" and list(shown.ColorArrayName) == ["CELLS", "Label"] and shown.Visibility == 1
         lines.append("%s: the cut shows Surface With Edges coloured by Label (%s, %s)" % ("ok" if ok else "FAIL", shown.Representation,
                                                                                          list(shown.ColorArrayName)))
+        # In 3D the labelled mesh's outer faces are the image box: the GUI shows the boundary instead.
+        volume = ps.Wavelet(WholeExtent=[0, 15, 0, 15, 0, 15])
+        mesh3 = DelaunayImageMesh(Nodes=FeatureNodes(Input=volume), Image=volume)  # noqa: F821
+        cut3 = SuperVoxelCut(Mesh=mesh3, ObjectSeeds=ps.PolyPointSource(Points=[8, 8, 8]),  # noqa: F821
+                             BackgroundSeeds=ps.PolyPointSource(Points=[1, 1, 1, 14, 14, 14]), Image=volume)
+        cut3.UpdatePipeline()
+        view = ps.GetActiveViewOrCreate("RenderView")
+        box, boundary = (ps.Show(ps.OutputPort(cut3, port), view) for port in (0, 1))
+        ok = box.Visibility == 0 and boundary.Visibility == 1
+        lines.append("%s: in 3D the cut shows its boundary, not the box of its labelled mesh (visibility %d, %d)"
+                     % ("ok" if ok else "FAIL", box.Visibility, boundary.Visibility))
         cells = sm.Fetch(mesh).GetNumberOfCells()
         lines.append(("ok: the GUI session meshes the image (%d triangles)" if cells > 0 else "FAIL: no mesh (%d cells)") % cells)
 except Exception:
