@@ -743,7 +743,8 @@ vtkInformationObjectBaseKey* OwnerMapKey()
 struct OwnerMapEntry
 {
   std::uint64_t Digest;
-  vtkWeakPointer<vtkIntArray> Map; // expires with the producer's output
+  vtkWeakPointer<vtkIntArray> Map;        // expires with the producer's output
+  vtkWeakPointer<vtkDataObject> Holder;   // that output, whose information holds the map
 };
 
 std::mutex OwnerMapsMutex;
@@ -766,7 +767,7 @@ void AttachVoxelOwners(vtkUnstructuredGrid* mesh, vtkIntArray* owner)
   std::lock_guard<std::mutex> lock(OwnerMapsMutex);
   auto& maps = OwnerMaps();
   maps.erase(std::remove_if(maps.begin(), maps.end(), [](const OwnerMapEntry& e) { return !e.Map; }), maps.end());
-  maps.push_back({ digest, owner });
+  maps.push_back({ digest, owner, mesh });
 }
 
 namespace
@@ -810,6 +811,26 @@ void StopVoxelOwnersRequest(vtkInformationVector* portVector)
   }
 }
 
+
+void ReleaseVoxelOwners(vtkUnstructuredGrid* mesh)
+{
+  const std::uint64_t digest = MeshDigest(mesh);
+  std::vector<vtkSmartPointer<vtkDataObject>> holders;
+  {
+    std::lock_guard<std::mutex> lock(OwnerMapsMutex);
+    for (const OwnerMapEntry& e : OwnerMaps())
+    {
+      if (e.Digest == digest && e.Holder)
+      {
+        holders.emplace_back(e.Holder.GetPointer());
+      }
+    }
+  }
+  for (vtkDataObject* holder : holders)
+  {
+    DropVoxelOwners(holder);
+  }
+}
 
 void DropVoxelOwners(vtkDataObject* object)
 {

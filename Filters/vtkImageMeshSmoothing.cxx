@@ -66,6 +66,10 @@ int vtkImageMeshSmoothing::RequestData(
       VoxelValuedImage(vtkImageData::GetData(inputVector[1], 0), this->GetInputArrayInformation(0));
     vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
     DropVoxelOwners(output); // the last run's map, which the executive's reset leaves on the object
+    if (input)
+    {
+      ReleaseVoxelOwners(input); // this stage rasterises its own moved mesh
+    }
     std::string error, warning;
     auto fail = [&](const std::string& why) {
       vtkErrorMacro("Image Mesh Smoothing: " << why);

@@ -7,8 +7,8 @@ hold on a resampled image) and reports each stage's seconds (stage 3's also spli
 quality refinement, sliver perturbation and statistics), the total, seconds per million voxels,
 the elements and the process's peak resident memory after each stage (the last is the run's peak);
 then, in a second process, the seconds and peak of the same pipeline updated at once, as a script
-runs it (at_once_s, at_once_peak_gb: ParaView's Apply updates one stage at a time, which keeps
-stage 2's owner map). The resampled images (linear interpolation, the same first and last voxel
+runs it (at_once_s, at_once_peak_gb: ParaView's Apply updates one stage at a time, where stage 2
+makes its owner map and stage 3 releases it). The resampled images (linear interpolation, the same first and last voxel
 centres) are written to a temporary folder first. Writes OUT.md and OUT.csv.
 """
 import argparse
