@@ -61,6 +61,17 @@ try:
         ok = box.Visibility == 0 and boundary.Visibility == 1
         lines.append("%s: in 3D the cut shows its boundary, not the box of its labelled mesh (visibility %d, %d)"
                      % ("ok" if ok else "FAIL", box.Visibility, boundary.Visibility))
+        # Feature Nodes made with RSP selected: RSP's image as Input, RSP as Edge Map (no Change Input).
+        rsp = RSPEdgeEnhancement(Input=image, ObjectSeeds=ps.PolyPointSource(Points=[24, 24, 0]),  # noqa: F821
+                                 BackgroundSeeds=ps.PolyPointSource(Points=[2, 2, 0]))
+        rsp.UpdatePipeline()  # as after its Apply
+        lines.append("%s: FeatureNodes is enabled with RSP Edge Enhancement selected" % ("ok" if enabled("FeatureNodes", rsp) else "FAIL"))
+        aware = FeatureNodes(Input=rsp)  # noqa: F821
+        ok = aware.Input.SMProxy == image.SMProxy and aware.EdgeMap is not None and aware.EdgeMap.SMProxy == rsp.SMProxy
+        aware.UpdatePipeline()
+        edges = sm.Fetch(aware, idx=1).GetPointData().GetArray("EdgeMap") if ok else None
+        lines.append("%s: FeatureNodes from RSP gets the image as Input and RSP as Edge Map (%s)"
+                     % ("ok" if ok and edges is not None else "FAIL", aware.Input.GetXMLName()))
         cells = sm.Fetch(mesh).GetNumberOfCells()
         lines.append(("ok: the GUI session meshes the image (%d triangles)" if cells > 0 else "FAIL: no mesh (%d cells)") % cells)
 except Exception:
