@@ -5,12 +5,18 @@
 #include "pqOutputPort.h"
 #include "pqPipelineSource.h"
 #include "pqServerManagerModel.h"
+#include "vtkNew.h"
+#include "vtkPVArrayInformation.h"
 #include "vtkPVDataInformation.h"
+#include "vtkPVDataSetAttributesInformation.h"
 #include "vtkSMPropertyHelper.h"
 #include "vtkSMProxy.h"
 #include "vtkSMSourceProxy.h"
+#include "vtkSMTransferFunctionManager.h"
+#include "vtkSMTransferFunctionProxy.h"
 
 #include <cstring>
+#include <string>
 
 pqFeatureMeshDisplay::pqFeatureMeshDisplay(QObject* parent)
   : QObject(parent)
@@ -58,6 +64,35 @@ void pqFeatureMeshDisplay::onStartup()
 
 void pqFeatureMeshDisplay::onShutdown() {}
 
+namespace
+{
+// The lookup table of every Label array: categories named after the labels (LabelNames), one colour
+// each, instead of a continuous ramp.
+void CategoricalLabels(vtkSMProxy* cut, vtkPVDataInformation* info)
+{
+  vtkNew<vtkSMTransferFunctionManager> manager;
+  vtkSMProxy* lut = manager->GetColorTransferFunction("Label", cut->GetSessionProxyManager());
+  if (!lut)
+  {
+    return;
+  }
+  vtkPVArrayInformation* given = info->GetFieldDataInformation()->GetArrayInformation("LabelNames");
+  const int labels = given ? given->GetNumberOfComponents() : 2;
+  vtkSMTransferFunctionProxy::ApplyPreset(lut, "KAAMS", false);
+  vtkSMPropertyHelper(lut, "InterpretValuesAsCategories").Set(1);
+  vtkSMPropertyHelper annotations(lut, "Annotations");
+  annotations.SetNumberOfElements(2 * labels);
+  for (int l = 0; l < labels; ++l)
+  {
+    const char* name = given ? given->GetComponentName(l) : nullptr;
+    const std::string text = name && *name ? name : l == 0 ? "background" : labels == 2 ? "object" : "label " + std::to_string(l);
+    annotations.Set(2 * l, std::to_string(l).c_str());
+    annotations.Set(2 * l + 1, text.c_str());
+  }
+  lut->UpdateVTKObjects();
+}
+} // namespace
+
 void pqFeatureMeshDisplay::hideBoxIn3D(pqPipelineSource* source, pqDataRepresentation* representation, int port)
 {
   if (port != 0 || !representation->isVisible())
@@ -65,6 +100,7 @@ void pqFeatureMeshDisplay::hideBoxIn3D(pqPipelineSource* source, pqDataRepresent
     return;
   }
   vtkPVDataInformation* info = source->getOutputPort(0)->getDataInformation();
+  CategoricalLabels(source->getProxy(), info);
   double bounds[6];
   info->GetBounds(bounds);
   if (info->GetNumberOfCells() > 0 && bounds[1] > bounds[0] && bounds[3] > bounds[2] && bounds[5] > bounds[4])

@@ -50,6 +50,10 @@ try:
         ok = shown.Representation == "Surface With Edges" and list(shown.ColorArrayName) == ["CELLS", "Label"] and shown.Visibility == 1
         lines.append("%s: the cut shows Surface With Edges coloured by Label (%s, %s)" % ("ok" if ok else "FAIL", shown.Representation,
                                                                                          list(shown.ColorArrayName)))
+        lut = ps.GetColorTransferFunction("Label")
+        names = list(lut.Annotations)
+        ok = lut.InterpretValuesAsCategories == 1 and names[:4] == ["0", "background", "1", "object"]
+        lines.append("%s: Label gets a categorical legend (%s)" % ("ok" if ok else "FAIL", names))
         # In 3D the labelled mesh's outer faces are the image box: the GUI shows the boundary instead.
         volume = ps.Wavelet(WholeExtent=[0, 15, 0, 15, 0, 15])
         mesh3 = DelaunayImageMesh(Nodes=FeatureNodes(Input=volume), Image=volume)  # noqa: F821

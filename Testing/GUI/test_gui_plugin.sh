@@ -10,6 +10,6 @@ timeout 240 "$paraview" --plugin-search-paths="$plugin_dir" --plugins=FeatureMes
 status=$?
 [ -f "$FEATUREMESH_GUI_OUT" ] || { echo "FAIL: ParaView wrote no result (exit $status); log:"; tail -20 "$work/paraview.log"; exit 1; }
 cat "$FEATUREMESH_GUI_OUT"
-if grep -q '^FAIL' "$FEATUREMESH_GUI_OUT" || [ "$(grep -c '^ok' "$FEATUREMESH_GUI_OUT")" -lt 13 ]; then
+if grep -q '^FAIL' "$FEATUREMESH_GUI_OUT" || [ "$(grep -c '^ok' "$FEATUREMESH_GUI_OUT")" -lt 14 ]; then
   exit 1
 fi
