@@ -740,11 +740,11 @@ vtkInformationObjectBaseKey* OwnerMapKey()
   return key;
 }
 
+// A stage output holding a map, and the digest of the points and cells the map was made for.
 struct OwnerMapEntry
 {
   std::uint64_t Digest;
-  vtkWeakPointer<vtkIntArray> Map;        // expires with the producer's output
-  vtkWeakPointer<vtkDataObject> Holder;   // that output, whose information holds the map
+  vtkWeakPointer<vtkDataObject> Holder;
 };
 
 std::mutex OwnerMapsMutex;
@@ -765,9 +765,7 @@ void AttachVoxelOwners(vtkUnstructuredGrid* mesh, vtkIntArray* owner)
   mesh->GetInformation()->Set(OwnerMapKey(), owner);
   const std::uint64_t digest = MeshDigest(mesh);
   std::lock_guard<std::mutex> lock(OwnerMapsMutex);
-  auto& maps = OwnerMaps();
-  maps.erase(std::remove_if(maps.begin(), maps.end(), [](const OwnerMapEntry& e) { return !e.Map; }), maps.end());
-  maps.push_back({ digest, owner, mesh });
+  OwnerMaps().push_back({ digest, mesh });
 }
 
 namespace
@@ -835,6 +833,12 @@ void ReleaseVoxelOwners(vtkUnstructuredGrid* mesh)
 void DropVoxelOwners(vtkDataObject* object)
 {
   object->GetInformation()->Remove(OwnerMapKey());
+  // Its entry goes too, with those of outputs that no longer exist.
+  std::lock_guard<std::mutex> lock(OwnerMapsMutex);
+  auto& maps = OwnerMaps();
+  maps.erase(std::remove_if(maps.begin(), maps.end(),
+               [object](const OwnerMapEntry& e) { return !e.Holder || e.Holder == object; }),
+    maps.end());
 }
 
 bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, VoxelOwnerMap& owner)
@@ -845,8 +849,10 @@ bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, VoxelOw
     std::lock_guard<std::mutex> lock(OwnerMapsMutex);
     for (const OwnerMapEntry& e : OwnerMaps())
     {
-      vtkSmartPointer<vtkIntArray> map = e.Map.GetPointer();
-      if (e.Digest == digest && map && map->GetNumberOfComponents() == 1 && map->GetNumberOfTuples() == voxels)
+      vtkIntArray* map = e.Digest == digest && e.Holder
+        ? vtkIntArray::SafeDownCast(e.Holder->GetInformation()->Get(OwnerMapKey()))
+        : nullptr;
+      if (map && map->GetNumberOfComponents() == 1 && map->GetNumberOfTuples() == voxels)
       {
         array = map;
       }
@@ -856,14 +862,8 @@ bool AttachedVoxelOwners(vtkUnstructuredGrid* mesh, std::int64_t voxels, VoxelOw
   {
     return false;
   }
-  const std::int32_t* p = array->GetPointer(0);
-  const vtkIdType cells = mesh->GetNumberOfCells();
-  // Ids must name cells: a map edited by hand is not trusted (and not left in `owner`).
-  if (!std::all_of(p, p + voxels, [cells](std::int32_t e) { return e >= -1 && e < cells; }))
-  {
-    return false;
-  }
-  owner.View(p, voxels, std::make_shared<vtkSmartPointer<vtkIntArray>>(array));
+  // No one edits the map (it is on no data object's arrays): the same points and cells, the same ids.
+  owner.View(array->GetPointer(0), voxels, std::make_shared<vtkSmartPointer<vtkIntArray>>(array));
   return true;
 }
 
@@ -918,27 +918,13 @@ vtkSmartPointer<vtkImageData> VoxelValuedImage(vtkImageData* image, vtkInformati
       half[a] = 0.5;
     }
   }
-  // The first cell's centre in world coordinates, through the direction matrix.
-  double firstCentre[3];
-  image->TransformContinuousIndexToPhysicalPoint(
-    extent[0] + half[0], extent[2] + half[1], extent[4] + half[2], firstCentre);
+  // Index i of the new image is the old continuous index i + 1/2: its origin is the old (1/2, ...).
+  double origin[3];
+  image->TransformContinuousIndexToPhysicalPoint(half[0], half[1], half[2], origin);
   vtkNew<vtkImageData> voxels;
   voxels->SetExtent(extent);
   voxels->SetSpacing(image->GetSpacing());
   voxels->SetDirectionMatrix(image->GetDirectionMatrix());
-  double origin[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    origin[a] = image->GetOrigin()[a];
-  }
-  // Shift the origin so that index `extent[0..]` lands on the first cell's centre.
-  double atFirst[3];
-  voxels->SetOrigin(origin);
-  voxels->TransformIndexToPhysicalPoint(extent[0], extent[2], extent[4], atFirst);
-  for (int a = 0; a < 3; ++a)
-  {
-    origin[a] += firstCentre[a] - atFirst[a];
-  }
   voxels->SetOrigin(origin);
   voxels->GetPointData()->ShallowCopy(cells);
   voxels->GetPointData()->RemoveArray(vtkDataSetAttributes::GhostArrayName());

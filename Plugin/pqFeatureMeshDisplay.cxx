@@ -57,7 +57,7 @@ void pqFeatureMeshDisplay::onStartup()
       {
         // Emitted while the controller registers the representation, before it pushes the
         // representation's properties and the view first renders it.
-        QObject::connect(source, &pqPipelineSource::representationAdded, this, &pqFeatureMeshDisplay::hideBoxIn3D);
+        QObject::connect(source, &pqPipelineSource::representationAdded, this, &pqFeatureMeshDisplay::onCutShown);
       }
     });
 }
@@ -93,7 +93,7 @@ void CategoricalLabels(vtkSMProxy* cut, vtkPVDataInformation* info)
 }
 } // namespace
 
-void pqFeatureMeshDisplay::hideBoxIn3D(pqPipelineSource* source, pqDataRepresentation* representation, int port)
+void pqFeatureMeshDisplay::onCutShown(pqPipelineSource* source, pqDataRepresentation* representation, int port)
 {
   if (port != 0 || !representation->isVisible())
   {

@@ -19,7 +19,8 @@ public:
   void onShutdown();
 
 private Q_SLOTS:
-  void hideBoxIn3D(pqPipelineSource* source, pqDataRepresentation* representation, int port);
+  // A cut shown: a categorical Label legend; in 3D its labelled mesh hidden.
+  void onCutShown(pqPipelineSource* source, pqDataRepresentation* representation, int port);
 };
 
 #endif

@@ -341,11 +341,6 @@ std::int64_t DelaunayFlips(const ImageGeometry& g, const std::vector<V3>& indexP
   return flips;
 }
 
-// Raises the minimum dihedral angle of slivers, keeping the topology: each free vertex of a
-// tetrahedron whose minimum dihedral angle is below `sliverAngle` tries steps along the normals of
-// its slivers' opposite faces (the directions that open a flat tetrahedron) and along the axes,
-// of 1/4, 1/8 and 1/16 of its shortest edge, and takes the one that most improves its star's worst
-// element. Vertices in id order, passes until none moves. Returns the moves made.
 // Nodes within this many voxels of a box face (along its normal) are moved onto it before the 3D
 // refinement, which keeps the box faces as they are: a node one voxel off the box leaves a slab one
 // voxel thick between it and the face, and nodes spread several voxels along the face can only fill
@@ -387,8 +382,12 @@ std::int64_t SnapNodesToBox(const ImageGeometry& g, std::vector<V3>& points)
       {
         for (int d2 = -1; d2 <= 1; ++d2)
         {
-          auto it = boxNodes.find({ { at[0] + d0, at[1] + d1, at[2] + d2 } });
-          for (const V3& q : it == boxNodes.end() ? std::vector<V3>() : it->second)
+          const auto it = boxNodes.find({ { at[0] + d0, at[1] + d1, at[2] + d2 } });
+          if (it == boxNodes.end())
+          {
+            continue;
+          }
+          for (const V3& q : it->second)
           {
             if (std::fabs(q[0] - to[0]) < 0.25 && std::fabs(q[1] - to[1]) < 0.25 && std::fabs(q[2] - to[2]) < 0.25)
             {
@@ -430,6 +429,11 @@ std::int64_t SnapNodesToBox(const ImageGeometry& g, std::vector<V3>& points)
   return moved;
 }
 
+// Raises the minimum dihedral angle of slivers, keeping the topology: each free vertex of a
+// tetrahedron whose minimum dihedral angle is below `sliverAngle` tries steps along the normals of
+// its slivers' opposite faces (the directions that open a flat tetrahedron) and along the axes,
+// of 1/4, 1/8 and 1/16 of its shortest edge, and takes the one that most improves its star's worst
+// element. Vertices in id order, passes until none moves. Returns the moves made.
 std::int64_t PerturbSlivers(Smoother& s, double sliverAngle, int passes, const ParallelFor& parallel, const ProgressFunction& progress,
   bool& aborted)
 {

@@ -140,16 +140,14 @@ def voxel_valued(source):
         if extent[2 * a + 1] > extent[2 * a]:
             extent[2 * a + 1] -= 1
             half[a] = 0.5
+    # Index i of the new image is the old continuous index i + 1/2: its origin is the old (1/2, ...).
+    origin = [0.0, 0.0, 0.0]
+    cells.TransformContinuousIndexToPhysicalPoint(*half, origin)
     image = vtkImageData()
     image.SetExtent(extent)
     image.SetSpacing(cells.GetSpacing())
     image.SetDirectionMatrix(cells.GetDirectionMatrix())
-    first = [0.0, 0.0, 0.0]
-    cells.TransformContinuousIndexToPhysicalPoint(*[extent[2 * a] + half[a] for a in range(3)], first)
-    image.SetOrigin(cells.GetOrigin())
-    at = [0.0, 0.0, 0.0]
-    image.TransformIndexToPhysicalPoint(extent[0], extent[2], extent[4], at)
-    image.SetOrigin(*[o + f - t for o, f, t in zip(cells.GetOrigin(), first, at)])
+    image.SetOrigin(origin)
     image.GetPointData().ShallowCopy(cells.GetCellData())
     image.GetPointData().RemoveArray(vtkDataSetAttributes.GhostArrayName())
     producer = ps.TrivialProducer()
