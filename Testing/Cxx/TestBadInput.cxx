@@ -385,6 +385,42 @@ TEST(FeatureNodes, Infinity)
   auto image = Image({ { 32, 32, 1 } }, [](int i, int, int) { return i == 3 ? -Inf : 1.0 * i; }, VTK_DOUBLE);
   FeatureNodes(image, [](auto& run, vtkPolyData* out) { ExpectError(run, "infinite", out); });
 }
+// Images whose values are cell data (as ParaView's GDAL reader gives a PNG): read at the cell centres.
+vtkSmartPointer<vtkImageData> CellValued(vtkImageData* voxels)
+{
+  auto cells = vtkSmartPointer<vtkImageData>::New();
+  int dims[3];
+  voxels->GetDimensions(dims);
+  cells->SetDimensions(dims[0] + 1, dims[1] + 1, dims[2] > 1 ? dims[2] + 1 : 1);
+  cells->GetCellData()->SetScalars(voxels->GetPointData()->GetScalars());
+  return cells;
+}
+TEST(FeatureNodes, CellDataImageIsReadAtTheCellCentres)
+{
+  auto cells = CellValued(Image({ { 48, 40, 1 } }, Noisy(20, 18, 0, 10)));
+  FeatureNodes(cells, [&](auto& run, vtkPolyData* out) {
+    ASSERT_TRUE(run.Log->Errors.empty()) << run.Log->All();
+    ASSERT_GT(out->GetNumberOfPoints(), 20);
+    for (vtkIdType i = 0; i < out->GetNumberOfPoints(); ++i)
+    {
+      double x[3];
+      out->GetPoint(i, x);
+      ASSERT_EQ(x[0] - 0.5, std::round(x[0] - 0.5)) << "node " << i << " is not on a cell centre";
+      ASSERT_EQ(x[1] - 0.5, std::round(x[1] - 0.5)) << "node " << i << " is not on a cell centre";
+      ASSERT_TRUE(x[0] > 0 && x[0] < 48 && x[1] > 0 && x[1] < 40);
+    }
+  });
+}
+TEST(FeatureNodes, CellDataWithThreeComponents)
+{
+  auto cells = CellValued(Image({ { 32, 32, 1 } }, [](int i, int, int) { return i; }, VTK_FLOAT, 3));
+  FeatureNodes(cells, [](auto& run, vtkPolyData* out) { ExpectError(run, "components", out); });
+}
+TEST(FeatureNodes, OneCell)
+{
+  auto cells = CellValued(Image({ { 1, 1, 1 } }, [](int, int, int) { return 1.0; }));
+  FeatureNodes(cells, [](auto& run, vtkPolyData* out) { ExpectError(run, "at least 2 voxels", out); });
+}
 TEST(FeatureNodes, StepsNearTheFloatLimit)
 {
   auto image = Image({ { 64, 64, 1 } }, [](int i, int j, int) { return std::hypot(i - 31.5, j - 30) < 16 ? 3e38 : -3e38; });
