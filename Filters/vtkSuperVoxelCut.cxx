@@ -410,14 +410,21 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
   const ParallelFor parallel = SMPParallelFor();
   const int channels = values->GetNumberOfComponents();
   std::string error;
-  if (data.Bins.Channels != channels || data.Bins.PerChannel != BinsPerChannel(channels, par.Bins))
+  int perChannel = 0;
+  switch (values->GetDataType())
+  {
+    vtkTemplateMacro(perChannel = SeedBinsPerChannel(static_cast<const VTK_TT*>(values->GetVoidPointer(0)), channels,
+                       geometry, par.SampleSeedElements ? data.Cut.Owner.data() : nullptr, seeds, par.SeedRadius,
+                       par.Bins, par.Bandwidth));
+  }
+  if (data.Bins.Channels != channels || data.Bins.PerChannel != perChannel)
   {
     data.Bins = ChannelBins();
     bool binned = false;
     switch (values->GetDataType())
     {
       vtkTemplateMacro(const VTK_TT* v = static_cast<const VTK_TT*>(values->GetVoidPointer(0));
-                       binned = BinChannels(v, channels, geometry.Size(), par.Bins, data.Bins, error, parallel);
+                       binned = BinChannels(v, channels, geometry.Size(), perChannel, data.Bins, error, parallel);
                        if (binned) {
                          NodeChannelMeans(data.Cut.Owner.data(), v, channels, geometry.Size(), mesh.NumberOfElements(),
                            data.ChannelMean, data.ChannelCount);

@@ -189,7 +189,9 @@ int vtkVoxelCut::RequestMultiLabel(const featuremesh::LabelledSeeds& seeds, vtkD
   switch (array->GetDataType())
   {
     vtkTemplateMacro(const VTK_TT* v = static_cast<const VTK_TT*>(array->GetVoidPointer(0));
-                     binned = BinChannels(v, channels, n, par.Bins, bins, error, SMPParallelFor());
+                     binned = BinChannels(v, channels, n,
+                       SeedBinsPerChannel(v, channels, geometry, nullptr, seeds, par.SeedRadius, par.Bins, par.Bandwidth),
+                       bins, error, SMPParallelFor());
                      if (binned) { values.assign(v, v + n * channels); });
     default:
       error = "the array's value type is not supported.";

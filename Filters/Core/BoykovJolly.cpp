@@ -123,6 +123,42 @@ std::vector<double> SmoothedHistogram(
   return density;
 }
 
+int AutomaticBins(const std::vector<WeightedSamples>& samples, double low, double high, double bandwidth)
+{
+  constexpr int base = 64;
+  const double width = (high - low) / base;
+  double narrowest = 1.0; // bandwidth in bins of `width`
+  for (const WeightedSamples& set : samples)
+  {
+    const std::vector<double>& s = *set.Values;
+    const std::vector<double>* w = set.Weights && !set.Weights->empty() ? set.Weights : nullptr;
+    double total = 0.0, mean = 0.0;
+    for (std::size_t i = 0; i < s.size(); ++i)
+    {
+      total += w ? (*w)[i] : 1.0;
+      mean += (w ? (*w)[i] : 1.0) * s[i];
+    }
+    if (s.size() < 2 || !(total > 0.0) || !(width > 0.0))
+    {
+      continue;
+    }
+    mean /= total;
+    double var = 0.0;
+    for (std::size_t i = 0; i < s.size(); ++i)
+    {
+      var += (w ? (*w)[i] : 1.0) * (s[i] - mean) * (s[i] - mean);
+    }
+    const double h = bandwidth * 1.06 * std::sqrt(var / total) * std::pow(static_cast<double>(s.size()), -0.2) / width;
+    // A density of one value is a spike at any bin width.
+    if (h > 0.0)
+    {
+      narrowest = std::min(narrowest, h);
+    }
+  }
+  // Up to half a bin the histogram's one-bin floor on the kernel widens it at most twice.
+  return narrowest < 0.5 ? static_cast<int>(std::min(4096.0, std::ceil(base / narrowest))) : base;
+}
+
 namespace
 {
 // The value types a NodeVoxelValues may view, by ValueType.
@@ -712,7 +748,6 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   {
     return r;
   }
-  r.Bins = par.Bins > 0 ? par.Bins : 64;
   const NodeVoxelValues* exact = pr.NodeVoxels;
   double low = exact ? exact->Low : Percentile(pr.Value.data(), n, 0.5);
   double high = exact ? exact->High : Percentile(pr.Value.data(), n, 99.5);
@@ -730,6 +765,9 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   {
     high = low + 1.0;
   }
+  r.Bins = par.Bins > 0 ? par.Bins
+                        : AutomaticBins({ { &pr.ObjectSamples, &pr.ObjectWeights }, { &pr.BackgroundSamples, &pr.BackgroundWeights } },
+                            low, high, par.Bandwidth);
   const std::vector<double> pObject = SmoothedHistogram(pr.ObjectSamples, pr.ObjectWeights, low, high, r.Bins, par.Bandwidth);
   const std::vector<double> pBackground =
     SmoothedHistogram(pr.BackgroundSamples, pr.BackgroundWeights, low, high, r.Bins, par.Bandwidth);

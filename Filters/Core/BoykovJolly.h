@@ -25,7 +25,7 @@ namespace featuremesh
 {
 struct BoykovJollyParameters
 {
-  // Histogram bins; 0 = automatic (64).
+  // Histogram bins; 0 = automatic (AutomaticBins: 64, or more when the seeds' densities need them).
   int Bins = 0;
   // Boundary-term sigma (intensity units); 0 = automatic: the root mean square of the intensity
   // differences over all graph edges.
@@ -129,6 +129,19 @@ std::string ValidateParameters(const BoykovJollyParameters& p);
 // one bin), on [low, high]; mixed with 1 % uniform.
 std::vector<double> SmoothedHistogram(const std::vector<double>& samples, const std::vector<double>& weights,
   double low, double high, int bins, double bandwidth = 1.0);
+
+// A seed density's samples and their weights (empty: 1 each).
+struct WeightedSamples
+{
+  const std::vector<double>* Values = nullptr;
+  const std::vector<double>* Weights = nullptr;
+};
+
+// The histogram's bins when Bins is 0 (automatic) on [low, high]: 64, or more (at most 4096) when
+// the narrowest seed density's Silverman bandwidth (times `bandwidth`) is under half of one of 64
+// bins, so that it spans one bin. 64 bins of a CT's robust range (air to bone) put a soft tissue's density
+// in one bin of 20 HU, where the kernel cannot resolve it and organs look alike.
+int AutomaticBins(const std::vector<WeightedSamples>& samples, double low, double high, double bandwidth);
 
 // What one cut keeps for the next cut of the same graph and node voxels. The max-flow (Kohli and
 // Torr's dynamic graph cuts): when the next cut differs only in terminal capacities (a seed edit), it

@@ -404,7 +404,58 @@ void NodeChannelMeans(const std::int32_t* owner, const T* values, int channels, 
   }
 }
 
+template <typename T>
+int SeedBinsPerChannel(const T* values, int channels, const ImageGeometry& g, const std::int32_t* owner,
+  const LabelledSeeds& seeds, double radius, int bins, double bandwidth)
+{
+  if (bins > 0 || channels != 1 || seeds.Voxel.empty())
+  {
+    return BinsPerChannel(channels, bins);
+  }
+  const std::int64_t voxels = g.Size();
+  std::vector<std::vector<double>> samples(LabelCount(seeds));
+  if (owner)
+  {
+    std::vector<std::int16_t> label;
+    for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
+    {
+      const std::int32_t p = owner[seeds.Voxel[s]];
+      if (p >= 0)
+      {
+        label.resize(std::max<std::size_t>(label.size(), static_cast<std::size_t>(p) + 1), -1);
+        label[p] = seeds.Label[s];
+      }
+    }
+    for (std::int64_t v = 0; v < voxels; ++v)
+    {
+      const std::int32_t p = owner[v];
+      if (p >= 0 && static_cast<std::size_t>(p) < label.size() && label[p] >= 0)
+      {
+        samples[label[p]].push_back(static_cast<double>(values[v]));
+      }
+    }
+  }
+  else
+  {
+    for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
+    {
+      ForEachVoxelWithin(g, seeds.Voxel[s], radius, [&](std::int64_t v) { samples[seeds.Label[s]].push_back(static_cast<double>(values[v])); });
+    }
+  }
+  const double low = ChannelPercentile(values, 1, 0, voxels, 0.5);
+  double high = ChannelPercentile(values, 1, 0, voxels, 99.5);
+  high = high > low ? high : low + 1.0;
+  std::vector<WeightedSamples> sets;
+  for (const std::vector<double>& s : samples)
+  {
+    sets.push_back({ &s, nullptr });
+  }
+  return AutomaticBins(sets, low, high, bandwidth);
+}
+
 #define FEATUREMESH_CHANNELS(T)                                                                                          \
+  template int SeedBinsPerChannel<T>(const T*, int, const ImageGeometry&, const std::int32_t*, const LabelledSeeds&,     \
+    double, int, double);                                                                                                \
   template bool BinChannels<T>(const T*, int, std::int64_t, int, ChannelBins&, std::string&, const ParallelFor&);       \
   template void NodeChannelMeans<T>(const std::int32_t*, const T*, int, std::int64_t, std::int64_t, std::vector<double>&, \
     std::vector<double>&);

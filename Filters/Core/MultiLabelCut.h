@@ -61,6 +61,14 @@ struct ChannelBins
 // 4096 bins (2 channels: 64 each; 3: 16).
 int BinsPerChannel(int channels, int bins);
 
+// Bins per channel for labelled seeds: BinsPerChannel(channels, bins), except with automatic bins
+// (0) on one channel: AutomaticBins (BoykovJolly.h) of each label's samples on the channel's
+// 0.5-99.5 percentile range. The samples are the voxels of the seeds' elements (`owner`, one per
+// voxel) or, without an owner map, those within `radius` of each seed, as the cuts sample them.
+template <typename T>
+int SeedBinsPerChannel(const T* values, int channels, const ImageGeometry& geometry, const std::int32_t* owner,
+  const LabelledSeeds& seeds, double radius, int bins, double bandwidth);
+
 // `values` (voxels x channels, interleaved, any arithmetic type) binned into `out`; false with a
 // sentence for a value that is not finite or beyond +-1e150.
 template <typename T>

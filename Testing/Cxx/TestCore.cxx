@@ -650,6 +650,44 @@ TEST(BoykovJolly, SeparatesTwoPlateausAndHonoursSeeds)
   EXPECT_FALSE(ValidateParameters(bad).empty());
 }
 
+TEST(BoykovJolly, AutomaticBinsResolveNarrowDensitiesInAWideRange)
+{
+  // A CT in miniature: object tissue near 52, background tissue near 44 and air near -1000. With 64
+  // bins over the range both tissues share a bin and the background tissue looks like the object;
+  // the automatic bins resolve the seeds' densities and tell them apart.
+  std::vector<double> values;
+  const double wobble[3] = { -1.5, 0.0, 1.5 };
+  for (int i = 0; i < 30; ++i)
+  {
+    values.push_back((i < 10 ? 52.0 : (i < 20 ? 44.0 : -1000.0)) + wobble[i % 3]);
+  }
+  CutProblem pr = SeededChain(values);
+  for (int i = 0; i < 6; ++i)
+  {
+    pr.ObjectSamples.push_back(52.0 + wobble[i % 3]);
+    pr.BackgroundSamples.push_back(44.0 + wobble[i % 3]);
+    pr.BackgroundSamples.push_back(-1000.0 + wobble[i % 3]);
+  }
+  BoykovJollyParameters par;
+  par.Lambda = 5.0;
+  const CutResult fine = BoykovJollyCut(pr, par);
+  ASSERT_TRUE(fine.Error.empty());
+  EXPECT_GT(fine.Bins, 64);
+  for (int i = 0; i < 30; ++i)
+    EXPECT_EQ(fine.Label[i], i < 10 ? 1 : 0) << i;
+  par.Bins = 64;
+  const CutResult coarse = BoykovJollyCut(pr, par);
+  ASSERT_TRUE(coarse.Error.empty());
+  EXPECT_EQ(coarse.Label[15], 1);
+  // Wide densities keep 64 bins.
+  const std::vector<double> wide = { 0.0, 10.0, 20.0, 30.0, 40.0 };
+  EXPECT_EQ(AutomaticBins({ { &wide, nullptr } }, 0.0, 40.0, 1.0), 64);
+  const std::vector<double> narrow = { 20.0, 20.1, 20.2, 20.3 };
+  EXPECT_GT(AutomaticBins({ { &wide, nullptr }, { &narrow, nullptr } }, 0.0, 40.0, 1.0), 64);
+  const std::vector<double> spike = { 7.0, 7.0, 7.0 };
+  EXPECT_EQ(AutomaticBins({ { &spike, nullptr } }, 0.0, 40.0, 1.0), 64);
+}
+
 TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
 {
   // Super-nodes of one voxel each: the voxel region term must equal the mean-based one.

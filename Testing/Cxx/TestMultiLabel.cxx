@@ -301,6 +301,46 @@ TEST(MultiLabel, TheSecondChannelTellsTheLabelsApart)
   EXPECT_LT(p.Correct(m.Cut(p.Seeds, sp)), 0.8);
 }
 
+TEST(MultiLabel, AutomaticBinsTellTissuesOfACTApart)
+{
+  // Bands of air (-1000), tissue at 44 and tissue at 52, a little noise: 64 bins over the range put
+  // both tissues in one bin; the seeds' automatic bins (one channel) resolve them, on voxels and on
+  // elements. Two channels keep the 64 x 64 grid.
+  const ImageGeometry g = Grid(60, 40);
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.f, 1.5f);
+  const float level[3] = { -1000.f, 44.f, 52.f };
+  const std::vector<float> ct = Image(g, 1, [&](int i, int, int) { return level[Plateaus::Truth(i)] + noise(rng); });
+  const Plateaus p;
+  VoxelCutParameters vp;
+  vp.Task = Task::Class;
+  const int automatic = SeedBinsPerChannel(ct.data(), 1, g, nullptr, p.Seeds, vp.SeedRadius, 0, vp.Bandwidth);
+  EXPECT_GT(automatic, 64);
+  EXPECT_EQ(SeedBinsPerChannel(ct.data(), 1, g, nullptr, p.Seeds, vp.SeedRadius, 32, vp.Bandwidth), 32);
+  const std::vector<float> two = Image(g, 2, [&](int i, int, int) { return level[Plateaus::Truth(i)] + noise(rng); });
+  EXPECT_EQ(SeedBinsPerChannel(two.data(), 2, g, nullptr, p.Seeds, vp.SeedRadius, 0, vp.Bandwidth), 64);
+  auto voxelCut = [&](int bins) {
+    ChannelBins b;
+    std::string error;
+    EXPECT_TRUE(BinChannels(ct.data(), 1, g.Size(), bins, b, error, SerialFor())) << error;
+    const MultiLabelResult r = MultiLabelVoxelCut(std::vector<double>(ct.begin(), ct.end()), b, g, p.Seeds, vp, MultiLabelParameters());
+    EXPECT_TRUE(r.Error.empty()) << r.Error;
+    return r.Label;
+  };
+  EXPECT_LT(p.Correct(voxelCut(64)), 0.8);
+  EXPECT_GT(p.Correct(voxelCut(automatic)), 0.98);
+  Lattice m;
+  ASSERT_TRUE(m.Make(g, ct, 1));
+  const int elementBins = SeedBinsPerChannel(ct.data(), 1, g, m.Data.Owner.data(), p.Seeds, vp.SeedRadius, 0, vp.Bandwidth);
+  EXPECT_GT(elementBins, 64);
+  std::string error;
+  ASSERT_TRUE(BinChannels(ct.data(), 1, g.Size(), elementBins, m.Bins, error, SerialFor()));
+  m.Runs = GroupNodeBins(m.Data.Owner.data(), m.Bins, m.Mesh.NumberOfElements());
+  SuperVoxelCutParameters sp;
+  sp.Task = Task::Class;
+  EXPECT_GT(p.Correct(m.Cut(p.Seeds, sp)), 0.95);
+}
+
 TEST(MultiLabel, TwoObjectsThatLookAlikeTakeTheirSeedsLabels)
 {
   // Two disks of one intensity with labels 1 and 2 (left and right kidney, say): by appearance
