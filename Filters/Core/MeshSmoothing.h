@@ -36,8 +36,9 @@ enum class SmoothingMethod
 struct MeshSmoothingParameters
 {
   SmoothingMethod Method = SmoothingMethod::ODT;
-  // Thesis 2.3: five iterations.
-  int Iterations = 5;
+  // Three sweeps: the thesis's five give the same angles after refinement, an oracle Dice within
+  // 0.004 and 6-8 % fewer elements in 3D, for 0.5-0.6 s more on BraTS (docs/smoothing.md).
+  int Iterations = 3;
   // Gaussian sigma (voxels) of the smoothing before the gradient magnitude.
   double Sigma = 1.0;
   // Weight of the gradient in the density; 0 gives plain (unweighted) CVT / ODT.
