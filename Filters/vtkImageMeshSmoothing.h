@@ -13,7 +13,7 @@
  * free nodes on the image box slide in their face or edge; box corners stay. The output has the same
  * points (moved) and point arrays, new elements, and stage 2's cell arrays recomputed exactly, with
  * its own voxel owner map; it asks its input for none (docs/CONTRACT.md).
- * See Filters/Core/MeshSmoothing.h.
+ * See Filters/Core/Smoothing/MeshSmoothing.h.
  */
 #ifndef vtkImageMeshSmoothing_h
 #define vtkImageMeshSmoothing_h

@@ -11,7 +11,7 @@
  * statistics dropped; its boundary nodes are output 0's points. Point array Shortfall: how far a
  * boundary node stopped from its smoothed position. Nodes on the image box stay
  * on it. With several objects, junction curves (three labels) move along themselves and junction
- * points stay. See Filters/Core/SurfaceSmoothing.h.
+ * points stay. See Filters/Core/Smoothing/SurfaceSmoothing.h.
  */
 #ifndef vtkSegmentationSurfaceSmoothing_h
 #define vtkSegmentationSurfaceSmoothing_h
