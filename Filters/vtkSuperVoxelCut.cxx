@@ -327,7 +327,7 @@ int vtkSuperVoxelCut::RequestData(
     {
       return fail(result.Error);
     }
-    this->UpdateProgress(0.7);
+    this->UpdateProgress(0.95);
     const CutResult& cut = result.Cut;
 
     this->WriteLabels(input, cut.Label, result.BoundaryFaces, outputVector);
@@ -483,6 +483,8 @@ void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
      << indent << "SuperVoxelIds: " << this->SuperVoxelIds << "\n"
      << indent << "ScaleByContact: " << this->ScaleByContact << "\n"
      << indent << "VoxelRegionTerm: " << this->VoxelRegionTerm << "\n"
+     << indent << "SampleSeedElements: " << this->SampleSeedElements << "\n"
+     << indent << "SeedRadius: " << this->SeedRadius << "\n"
      << indent << "SeedLabelArray: " << this->SeedLabelArray << "\n"
      << indent << "ChannelModel: " << this->ChannelModel << "\n"
      << indent << "LabelNames: " << this->LabelNames << "\n";
