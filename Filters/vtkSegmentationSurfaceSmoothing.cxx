@@ -26,16 +26,22 @@ vtkStandardNewMacro(vtkSegmentationSurfaceSmoothing);
 
 vtkSegmentationSurfaceSmoothing::vtkSegmentationSurfaceSmoothing()
 {
-  const featuremesh::SurfaceSmoothingParameters defaults;
-  this->Method = static_cast<int>(defaults.Method);
-  this->Iterations = defaults.Iterations;
-  this->Relaxation = defaults.Relaxation;
-  this->PassBand = defaults.PassBand;
-  this->VolumeMesh = defaults.VolumeMesh;
-  this->MinAngle = defaults.MinAngle;
-  this->MinDihedralAngle = defaults.MinDihedralAngle;
-  this->RelaxationRings = defaults.RelaxationRings;
   this->SetNumberOfOutputPorts(2);
+}
+
+void vtkSegmentationSurfaceSmoothing::SetMethod(int method)
+{
+  const auto m = static_cast<featuremesh::SurfaceSmoothingMethod>(std::min(std::max(method, +LAPLACIAN), +TAUBIN));
+  if (m != this->Method)
+  {
+    this->Method = m;
+    this->Modified();
+  }
+}
+
+int vtkSegmentationSurfaceSmoothing::GetMethod()
+{
+  return static_cast<int>(this->Method);
 }
 
 int vtkSegmentationSurfaceSmoothing::FillInputPortInformation(int, vtkInformation* info)
@@ -66,15 +72,7 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
       return 0;
     };
 
-    SurfaceSmoothingParameters par;
-    par.Method = static_cast<SurfaceSmoothingMethod>(this->Method);
-    par.Iterations = this->Iterations;
-    par.Relaxation = this->Relaxation;
-    par.PassBand = this->PassBand;
-    par.VolumeMesh = this->VolumeMesh;
-    par.MinAngle = this->MinAngle;
-    par.MinDihedralAngle = this->MinDihedralAngle;
-    par.RelaxationRings = this->RelaxationRings;
+    const SurfaceSmoothingParameters& par = *this;
     error = ValidateParameters(par);
     if (!error.empty())
     {
@@ -223,7 +221,7 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
 void vtkSegmentationSurfaceSmoothing::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "Method: " << (this->Method == LAPLACIAN ? "Laplacian" : "Taubin") << "\n";
+  os << indent << "Method: " << (this->Method == featuremesh::SurfaceSmoothingMethod::Laplacian ? "Laplacian" : "Taubin") << "\n";
   os << indent << "Iterations: " << this->Iterations << "\n";
   os << indent << "Relaxation: " << this->Relaxation << "\n";
   os << indent << "PassBand: " << this->PassBand << "\n";

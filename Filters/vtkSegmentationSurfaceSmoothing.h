@@ -17,9 +17,14 @@
 #define vtkSegmentationSurfaceSmoothing_h
 
 #include "FeatureMeshFiltersModule.h"
+#include "SurfaceSmoothing.h" // the parameters, declared once
 #include "vtkPolyDataAlgorithm.h"
 
-class FEATUREMESHFILTERS_EXPORT vtkSegmentationSurfaceSmoothing : public vtkPolyDataAlgorithm
+// The filter is its Core parameters (TTK's shape): each property's value and default live in
+// featuremesh::SurfaceSmoothingParameters, which the setters write.
+class FEATUREMESHFILTERS_EXPORT vtkSegmentationSurfaceSmoothing
+  : public vtkPolyDataAlgorithm
+  , protected featuremesh::SurfaceSmoothingParameters
 {
 public:
   static vtkSegmentationSurfaceSmoothing* New();
@@ -32,8 +37,8 @@ public:
     TAUBIN = 1
   };
   /// Laplacian (the thesis, default) or Taubin (lambda|mu: does not shrink).
-  vtkSetClampMacro(Method, int, LAPLACIAN, TAUBIN);
-  vtkGetMacro(Method, int);
+  virtual void SetMethod(int method);
+  virtual int GetMethod();
   /// Iterations (default 3, the thesis); Taubin's iteration is one lambda and one mu step.
   vtkSetMacro(Iterations, int);
   vtkGetMacro(Iterations, int);
@@ -64,16 +69,6 @@ protected:
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int FillOutputPortInformation(int port, vtkInformation* info) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
-
-  // Defaults: featuremesh::SurfaceSmoothingParameters.
-  int Method;
-  int Iterations;
-  double Relaxation;
-  double PassBand;
-  bool VolumeMesh;
-  double MinAngle;
-  double MinDihedralAngle;
-  int RelaxationRings;
 
 private:
   vtkMTimeType FailedAt = 0;
