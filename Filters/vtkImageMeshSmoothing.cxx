@@ -20,21 +20,24 @@ vtkStandardNewMacro(vtkImageMeshSmoothing);
 
 vtkImageMeshSmoothing::vtkImageMeshSmoothing()
 {
-  const featuremesh::MeshSmoothingParameters defaults;
-  this->Method = static_cast<int>(defaults.Method);
-  this->Iterations = defaults.Iterations;
-  this->Sigma = defaults.Sigma;
-  this->FeatureWeight = defaults.FeatureWeight;
-  this->FixedNodeSlack = defaults.FixedNodeSlack;
-  this->Flips = defaults.Flips;
-  this->QualityRefinement = defaults.QualityRefinement;
-  this->MinAngle = defaults.MinAngle;
-  this->MinDihedralAngle = defaults.MinDihedralAngle;
-  this->SliverRemoval = defaults.SliverRemoval;
-  this->SliverAngle = defaults.SliverAngle;
   this->SetNumberOfInputPorts(2);
   this->SetInputArrayToProcess(
     0, 1, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+}
+
+void vtkImageMeshSmoothing::SetMethod(int method)
+{
+  const auto m = static_cast<featuremesh::SmoothingMethod>(std::min(std::max(method, +CVT), +ODT));
+  if (m != this->Method)
+  {
+    this->Method = m;
+    this->Modified();
+  }
+}
+
+int vtkImageMeshSmoothing::GetMethod()
+{
+  return static_cast<int>(this->Method);
 }
 
 int vtkImageMeshSmoothing::FillInputPortInformation(int port, vtkInformation* info)
@@ -76,18 +79,7 @@ int vtkImageMeshSmoothing::RequestData(
       return 0;
     };
 
-    MeshSmoothingParameters par;
-    par.Method = static_cast<SmoothingMethod>(this->Method);
-    par.Iterations = this->Iterations;
-    par.Sigma = this->Sigma;
-    par.FeatureWeight = this->FeatureWeight;
-    par.FixedNodeSlack = this->FixedNodeSlack;
-    par.Flips = this->Flips;
-    par.QualityRefinement = this->QualityRefinement;
-    par.MinAngle = this->MinAngle;
-    par.MinDihedralAngle = this->MinDihedralAngle;
-    par.SliverRemoval = this->SliverRemoval;
-    par.SliverAngle = this->SliverAngle;
+    const MeshSmoothingParameters& par = *this;
     error = ValidateParameters(par);
     if (!error.empty())
     {
@@ -204,7 +196,7 @@ int vtkImageMeshSmoothing::RequestData(
 void vtkImageMeshSmoothing::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "Method: " << (this->Method == CVT ? "CVT" : "ODT") << "\n";
+  os << indent << "Method: " << (this->GetMethod() == CVT ? "CVT" : "ODT") << "\n";
   os << indent << "Iterations: " << this->Iterations << "\n";
   os << indent << "Sigma: " << this->Sigma << "\n";
   os << indent << "FeatureWeight: " << this->FeatureWeight << "\n";

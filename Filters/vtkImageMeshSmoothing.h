@@ -19,9 +19,14 @@
 #define vtkImageMeshSmoothing_h
 
 #include "FeatureMeshFiltersModule.h"
+#include "MeshSmoothing.h" // the parameters, declared once
 #include "vtkUnstructuredGridAlgorithm.h"
 
-class FEATUREMESHFILTERS_EXPORT vtkImageMeshSmoothing : public vtkUnstructuredGridAlgorithm
+// The filter is its Core parameters (TTK's shape): each property's value and default live in
+// featuremesh::MeshSmoothingParameters, which the setters write.
+class FEATUREMESHFILTERS_EXPORT vtkImageMeshSmoothing
+  : public vtkUnstructuredGridAlgorithm
+  , protected featuremesh::MeshSmoothingParameters
 {
 public:
   static vtkImageMeshSmoothing* New();
@@ -34,8 +39,8 @@ public:
     ODT = 1
   };
   /// CVT (thesis eq. 10) or ODT (eq. 12, default).
-  vtkSetClampMacro(Method, int, CVT, ODT);
-  vtkGetMacro(Method, int);
+  virtual void SetMethod(int method);
+  virtual int GetMethod();
   /// Smoothing sweeps (default 5, the thesis's); 0 passes the mesh through.
   vtkSetMacro(Iterations, int);
   vtkGetMacro(Iterations, int);
@@ -77,19 +82,6 @@ protected:
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
-
-  // Defaults: featuremesh::MeshSmoothingParameters.
-  int Method;
-  int Iterations;
-  double Sigma;
-  double FeatureWeight;
-  double FixedNodeSlack;
-  bool Flips;
-  bool QualityRefinement;
-  double MinAngle;
-  double MinDihedralAngle;
-  bool SliverRemoval;
-  double SliverAngle;
 
 private:
   vtkMTimeType FailedAt = 0;
