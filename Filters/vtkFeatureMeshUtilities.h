@@ -41,6 +41,19 @@ struct MultiLabelResult;
 // failure); returns 0.
 int ReportException(vtkAlgorithm* algorithm, const char* filter, const std::exception_ptr& error);
 
+// A property's setter where the filter's Core parameter differs in name or type (an enumeration,
+// an unsigned or 64-bit count): the parameter takes the value, and the filter is Modified when it changed.
+template <typename Parameter, typename Value>
+void SetParameter(vtkObject* filter, Parameter& parameter, Value value)
+{
+  const Parameter v = static_cast<Parameter>(value);
+  if (parameter != v)
+  {
+    parameter = v;
+    filter->Modified();
+  }
+}
+
 // What a run depends on: the newest modification of the filter or of anything upstream, and the
 // requested time step (a time series changes the data, not the modification times).
 struct RunState

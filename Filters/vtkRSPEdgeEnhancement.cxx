@@ -26,20 +26,43 @@ vtkStandardNewMacro(vtkRSPEdgeEnhancement);
 
 vtkRSPEdgeEnhancement::vtkRSPEdgeEnhancement()
 {
-  const featuremesh::RSPParameters defaults;
-  this->GradientScale = defaults.GradientScale;
-  this->GradientSigma = defaults.GradientSigma;
-  this->NumberOfSources = defaults.Sources;
-  this->NumberOfSinks = defaults.Sinks;
-  this->SamplingThreshold = defaults.SamplingThreshold;
-  this->RandomSeed = static_cast<int>(defaults.RandomSeed);
-  this->PathMargin = defaults.PathMargin;
-  this->MaximumPathVoxels = static_cast<int>(defaults.MaximumPathVoxels);
-  this->EdgeThreshold = defaults.EdgeThreshold;
-  this->GapCost = defaults.GapCost;
   this->SetNumberOfInputPorts(3);
   this->SetNumberOfOutputPorts(3);
   this->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+}
+
+// Properties whose Core parameter has another name or type.
+void vtkRSPEdgeEnhancement::SetNumberOfSources(int value)
+{
+  featuremesh::SetParameter(this, this->Sources, value);
+}
+int vtkRSPEdgeEnhancement::GetNumberOfSources()
+{
+  return this->Sources;
+}
+void vtkRSPEdgeEnhancement::SetNumberOfSinks(int value)
+{
+  featuremesh::SetParameter(this, this->Sinks, value);
+}
+int vtkRSPEdgeEnhancement::GetNumberOfSinks()
+{
+  return this->Sinks;
+}
+void vtkRSPEdgeEnhancement::SetRandomSeed(int value)
+{
+  featuremesh::SetParameter(this, this->featuremesh::RSPParameters::RandomSeed, value);
+}
+int vtkRSPEdgeEnhancement::GetRandomSeed()
+{
+  return static_cast<int>(this->featuremesh::RSPParameters::RandomSeed);
+}
+void vtkRSPEdgeEnhancement::SetMaximumPathVoxels(int value)
+{
+  featuremesh::SetParameter(this, this->featuremesh::RSPParameters::MaximumPathVoxels, value);
+}
+int vtkRSPEdgeEnhancement::GetMaximumPathVoxels()
+{
+  return static_cast<int>(this->featuremesh::RSPParameters::MaximumPathVoxels);
 }
 
 int vtkRSPEdgeEnhancement::FillInputPortInformation(int port, vtkInformation* info)
@@ -112,17 +135,7 @@ int vtkRSPEdgeEnhancement::RequestData(vtkInformation*, vtkInformationVector** i
     {
       return fail(error);
     }
-    RSPParameters p;
-    p.GradientScale = this->GradientScale;
-    p.GradientSigma = this->GradientSigma;
-    p.Sources = this->NumberOfSources;
-    p.Sinks = this->NumberOfSinks;
-    p.SamplingThreshold = this->SamplingThreshold;
-    p.RandomSeed = static_cast<unsigned>(this->RandomSeed);
-    p.PathMargin = this->PathMargin;
-    p.MaximumPathVoxels = static_cast<std::int64_t>(this->MaximumPathVoxels);
-    p.EdgeThreshold = this->EdgeThreshold;
-    p.GapCost = this->GapCost;
+    const RSPParameters& p = *this;
     error = ValidateParameters(p);
     if (!error.empty())
     {
@@ -241,12 +254,12 @@ void vtkRSPEdgeEnhancement::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "GradientScale: " << this->GradientScale << "\n"
      << indent << "GradientSigma: " << this->GradientSigma << "\n"
-     << indent << "NumberOfSources: " << this->NumberOfSources << "\n"
-     << indent << "NumberOfSinks: " << this->NumberOfSinks << "\n"
+     << indent << "NumberOfSources: " << this->Sources << "\n"
+     << indent << "NumberOfSinks: " << this->Sinks << "\n"
      << indent << "SamplingThreshold: " << this->SamplingThreshold << "\n"
-     << indent << "RandomSeed: " << this->RandomSeed << "\n"
+     << indent << "RandomSeed: " << this->GetRandomSeed() << "\n"
      << indent << "PathMargin: " << this->PathMargin << "\n"
-     << indent << "MaximumPathVoxels: " << this->MaximumPathVoxels << "\n"
+     << indent << "MaximumPathVoxels: " << this->GetMaximumPathVoxels() << "\n"
      << indent << "EdgeThreshold: " << this->EdgeThreshold << "\n"
      << indent << "GapCost: " << this->GapCost << "\n";
 }

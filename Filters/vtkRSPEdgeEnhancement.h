@@ -15,9 +15,14 @@
 #define vtkRSPEdgeEnhancement_h
 
 #include "FeatureMeshFiltersModule.h"
+#include "RSPEdgeEnhancement.h" // the parameters, declared once
 #include "vtkImageAlgorithm.h"
 
-class FEATUREMESHFILTERS_EXPORT vtkRSPEdgeEnhancement : public vtkImageAlgorithm
+// The filter is its Core parameters (TTK's shape): each property's value and default live in
+// featuremesh::RSPParameters, which the setters write.
+class FEATUREMESHFILTERS_EXPORT vtkRSPEdgeEnhancement
+  : public vtkImageAlgorithm
+  , protected featuremesh::RSPParameters
 {
 public:
   static vtkRSPEdgeEnhancement* New();
@@ -32,18 +37,18 @@ public:
   vtkSetMacro(GradientSigma, double);
   vtkGetMacro(GradientSigma, double);
   /// Random sources and sinks. Defaults 50 and 100, the thesis's.
-  vtkSetMacro(NumberOfSources, int);
-  vtkGetMacro(NumberOfSources, int);
-  vtkSetMacro(NumberOfSinks, int);
-  vtkGetMacro(NumberOfSinks, int);
+  virtual void SetNumberOfSources(int value);
+  virtual int GetNumberOfSources();
+  virtual void SetNumberOfSinks(int value);
+  virtual int GetNumberOfSinks();
   /// T of the rejection sampler in marching-map units; 0 (default) = automatic.
   vtkSetMacro(SamplingThreshold, double);
   vtkGetMacro(SamplingThreshold, double);
-  vtkSetMacro(RandomSeed, int);
-  vtkGetMacro(RandomSeed, int);
+  virtual void SetRandomSeed(int value);
+  virtual int GetRandomSeed();
   /// Larger images run the paths on a coarser grid first (see featuremesh::RSPParameters); 0 = never.
-  vtkSetMacro(MaximumPathVoxels, int);
-  vtkGetMacro(MaximumPathVoxels, int);
+  virtual void SetMaximumPathVoxels(int value);
+  virtual int GetMaximumPathVoxels();
   /// Voxels the paths may use beyond the box the marching maps reach. Default 8.
   vtkSetMacro(PathMargin, int);
   vtkGetMacro(PathMargin, int);
@@ -66,16 +71,6 @@ protected:
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  double GradientScale;
-  double GradientSigma;
-  int NumberOfSources;
-  int NumberOfSinks;
-  double SamplingThreshold;
-  int RandomSeed;
-  int PathMargin;
-  int MaximumPathVoxels;
-  double EdgeThreshold;
-  double GapCost;
 
 private:
   vtkMTimeType FailedAt = 0;
