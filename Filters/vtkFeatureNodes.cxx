@@ -27,23 +27,6 @@ vtkStandardNewMacro(vtkFeatureNodes);
 
 vtkFeatureNodes::vtkFeatureNodes()
 {
-  const featuremesh::FeatureNodeParameters defaults;
-  this->GaussianSigma = defaults.GaussianSigma;
-  this->HessianSigma = defaults.HessianSigma;
-  this->LowThreshold = defaults.LowThreshold;
-  this->HighThreshold = defaults.HighThreshold;
-  this->MaximumPercentile = defaults.MaximumPercentile;
-  this->NoiseFloor = defaults.NoiseFloor;
-  this->CovarianceNeighbourhood = defaults.CovarianceNeighbourhood;
-  this->Halftoning = defaults.Halftoning;
-  this->HalftoneThreshold = defaults.HalftoneThreshold;
-  this->HalftoneGamma = defaults.HalftoneGamma;
-  this->ExclusionWindow = defaults.ExclusionWindow;
-  this->UniformSpacing = defaults.UniformSpacing;
-  this->BoundarySpacing = defaults.BoundarySpacing;
-  this->SeedAware = defaults.SeedAware;
-  this->EdgeGateRadius = defaults.EdgeGateRadius;
-  this->CoarseningLevels = defaults.CoarseningLevels;
   this->SetNumberOfInputPorts(2);
   this->SetNumberOfOutputPorts(2);
   this->SetInputArrayToProcess(
@@ -116,23 +99,7 @@ int vtkFeatureNodes::Execute(vtkInformationVector** inputVector, vtkInformationV
     vtkErrorMacro("Feature Nodes: " << error);
     return 0;
   }
-  FeatureNodeParameters p;
-  p.GaussianSigma = this->GaussianSigma;
-  p.HessianSigma = this->HessianSigma;
-  p.LowThreshold = this->LowThreshold;
-  p.HighThreshold = this->HighThreshold;
-  p.MaximumPercentile = this->MaximumPercentile;
-  p.NoiseFloor = this->NoiseFloor;
-  p.CovarianceNeighbourhood = this->CovarianceNeighbourhood;
-  p.Halftoning = this->Halftoning;
-  p.HalftoneThreshold = this->HalftoneThreshold;
-  p.HalftoneGamma = this->HalftoneGamma;
-  p.ExclusionWindow = this->ExclusionWindow;
-  p.UniformSpacing = this->UniformSpacing;
-  p.BoundarySpacing = this->BoundarySpacing;
-  p.SeedAware = this->SeedAware;
-  p.EdgeGateRadius = this->EdgeGateRadius;
-  p.CoarseningLevels = this->CoarseningLevels;
+  const FeatureNodeParameters& p = *this;
   error = ValidateParameters(p);
   if (!error.empty())
   {

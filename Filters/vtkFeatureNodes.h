@@ -18,11 +18,16 @@
 #define vtkFeatureNodes_h
 
 #include "FeatureMeshFiltersModule.h"
+#include "FeatureNodes.h" // the parameters, declared once
 #include "vtkPolyDataAlgorithm.h"
 
 class vtkImageData;
 
-class FEATUREMESHFILTERS_EXPORT vtkFeatureNodes : public vtkPolyDataAlgorithm
+// The filter is its Core parameters (TTK's shape): each property's value and default live in
+// featuremesh::FeatureNodeParameters, which the setters write.
+class FEATUREMESHFILTERS_EXPORT vtkFeatureNodes
+  : public vtkPolyDataAlgorithm
+  , protected featuremesh::FeatureNodeParameters
 {
 public:
   static vtkFeatureNodes* New();
@@ -104,24 +109,6 @@ protected:
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int Execute(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
-
-  // Defaults: featuremesh::FeatureNodeParameters.
-  double GaussianSigma;
-  double HessianSigma;
-  double LowThreshold;
-  double HighThreshold;
-  double MaximumPercentile;
-  int CovarianceNeighbourhood;
-  bool Halftoning;
-  double HalftoneThreshold;
-  double HalftoneGamma;
-  int ExclusionWindow;
-  int UniformSpacing;
-  int BoundarySpacing;
-  bool SeedAware;
-  bool NoiseFloor;
-  int EdgeGateRadius;
-  int CoarseningLevels;
 
 private:
   // The pipeline state of the last failed run (0: none), so that it is not repeated.
