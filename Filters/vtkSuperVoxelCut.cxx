@@ -68,24 +68,51 @@ vtkSuperVoxelCut::~vtkSuperVoxelCut() = default;
 
 vtkSuperVoxelCut::vtkSuperVoxelCut()
 {
-  const featuremesh::SuperVoxelCutParameters defaults;
-  this->Bins = defaults.Bins;
-  this->Sigma = defaults.Sigma;
-  this->Lambda = defaults.Lambda;
-  this->Task = static_cast<int>(defaults.Task);
-  this->Connectivity = static_cast<int>(defaults.Connectivity);
-  this->GeodesicWeight = defaults.Geodesic.Weight;
-  this->GeodesicLength = defaults.Geodesic.LengthWeight;
-  this->Bandwidth = defaults.Bandwidth;
-  this->ScaleByContact = defaults.ScaleByContact;
-  this->VoxelRegionTerm = defaults.VoxelRegionTerm;
-  this->SampleSeedElements = defaults.SampleSeedElements;
-  this->SeedRadius = defaults.SeedRadius;
-  this->SeedLabelArray = featuremesh::names::Label;
-  this->ChannelModel = static_cast<int>(featuremesh::MultiLabelParameters().Channels);
   this->SetNumberOfInputPorts(5);
   this->SetNumberOfOutputPorts(3);
   this->SetInputArrayToProcess(0, 3, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+}
+
+// Properties whose Core parameter has another name or type.
+void vtkSuperVoxelCut::SetTask(int value)
+{
+  featuremesh::SetParameter(this, this->featuremesh::SeededCutParameters::Task, value);
+}
+int vtkSuperVoxelCut::GetTask()
+{
+  return static_cast<int>(this->featuremesh::SeededCutParameters::Task);
+}
+void vtkSuperVoxelCut::SetConnectivity(int value)
+{
+  featuremesh::SetParameter(this, this->featuremesh::SeededCutParameters::Connectivity, std::min(std::max(value, 0), 3));
+}
+int vtkSuperVoxelCut::GetConnectivity()
+{
+  return static_cast<int>(this->featuremesh::SeededCutParameters::Connectivity);
+}
+void vtkSuperVoxelCut::SetGeodesicWeight(double value)
+{
+  featuremesh::SetParameter(this, this->Geodesic.Weight, value);
+}
+double vtkSuperVoxelCut::GetGeodesicWeight()
+{
+  return this->Geodesic.Weight;
+}
+void vtkSuperVoxelCut::SetGeodesicLength(double value)
+{
+  featuremesh::SetParameter(this, this->Geodesic.LengthWeight, value);
+}
+double vtkSuperVoxelCut::GetGeodesicLength()
+{
+  return this->Geodesic.LengthWeight;
+}
+void vtkSuperVoxelCut::SetChannelModel(int value)
+{
+  featuremesh::SetParameter(this, this->Channels, std::min(std::max(value, 0), 1));
+}
+int vtkSuperVoxelCut::GetChannelModel()
+{
+  return static_cast<int>(this->Channels);
 }
 
 int vtkSuperVoxelCut::FillInputPortInformation(int port, vtkInformation* info)
@@ -155,19 +182,7 @@ int vtkSuperVoxelCut::RequestData(
       return 0;
     };
 
-    SuperVoxelCutParameters par;
-    par.Bins = this->Bins;
-    par.Sigma = this->Sigma;
-    par.Lambda = this->Lambda;
-    par.Task = static_cast<featuremesh::Task>(this->Task);
-    par.Connectivity = static_cast<featuremesh::Connectivity>(this->Connectivity);
-    par.Geodesic.Weight = this->GeodesicWeight;
-    par.Geodesic.LengthWeight = this->GeodesicLength;
-    par.Bandwidth = this->Bandwidth;
-    par.ScaleByContact = this->ScaleByContact;
-    par.VoxelRegionTerm = this->VoxelRegionTerm;
-    par.SampleSeedElements = this->SampleSeedElements;
-    par.SeedRadius = this->SeedRadius;
+    const SuperVoxelCutParameters& par = *this;
     error = ValidateParameters(par);
     if (!error.empty())
     {
@@ -442,8 +457,7 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
     data.Multi.Clear();
   }
   this->UpdateProgress(0.45);
-  MultiLabelParameters multi;
-  multi.Channels = static_cast<featuremesh::ChannelModel>(this->ChannelModel);
+  const MultiLabelParameters& multi = *this;
   const MultiLabelResult result = MultiLabelSuperVoxelCut(mesh, data.Cut, data.Bins, data.Runs, data.ChannelMean,
     data.ChannelCount, seeds, par, multi, parallel, AlgorithmProgress(this, 0.45, 0.95), &data.Multi);
   if (result.Aborted)
@@ -475,10 +489,10 @@ void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Bins: " << this->Bins << "\n"
      << indent << "Sigma: " << this->Sigma << "\n"
      << indent << "Lambda: " << this->Lambda << "\n"
-     << indent << "Task: " << this->Task << "\n"
-     << indent << "Connectivity: " << this->Connectivity << "\n"
-     << indent << "GeodesicWeight: " << this->GeodesicWeight << "\n"
-     << indent << "GeodesicLength: " << this->GeodesicLength << "\n"
+     << indent << "Task: " << this->GetTask() << "\n"
+     << indent << "Connectivity: " << this->GetConnectivity() << "\n"
+     << indent << "GeodesicWeight: " << this->GetGeodesicWeight() << "\n"
+     << indent << "GeodesicLength: " << this->GetGeodesicLength() << "\n"
      << indent << "Bandwidth: " << this->Bandwidth << "\n"
      << indent << "SuperVoxelIds: " << this->SuperVoxelIds << "\n"
      << indent << "ScaleByContact: " << this->ScaleByContact << "\n"
@@ -486,6 +500,6 @@ void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
      << indent << "SampleSeedElements: " << this->SampleSeedElements << "\n"
      << indent << "SeedRadius: " << this->SeedRadius << "\n"
      << indent << "SeedLabelArray: " << this->SeedLabelArray << "\n"
-     << indent << "ChannelModel: " << this->ChannelModel << "\n"
+     << indent << "ChannelModel: " << this->GetChannelModel() << "\n"
      << indent << "LabelNames: " << this->LabelNames << "\n";
 }

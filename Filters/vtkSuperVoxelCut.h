@@ -17,7 +17,10 @@
 #ifndef vtkSuperVoxelCut_h
 #define vtkSuperVoxelCut_h
 
+#include "Contract.h"
 #include "FeatureMeshFiltersModule.h"
+#include "MultiLabelCut.h" // the parameters, declared once
+#include "SuperVoxelCut.h"
 #include "vtkUnstructuredGridAlgorithm.h"
 
 #include <cstdint>
@@ -27,13 +30,12 @@
 
 class vtkDataArray;
 class vtkUnstructuredGrid;
-namespace featuremesh
-{
-struct LabelledSeeds;
-struct SuperVoxelCutParameters;
-}
-
-class FEATUREMESHFILTERS_EXPORT vtkSuperVoxelCut : public vtkUnstructuredGridAlgorithm
+// The filter is its Core parameters (TTK's shape): each energy property's value and default live in
+// featuremesh::SuperVoxelCutParameters and MultiLabelParameters, which the setters write.
+class FEATUREMESHFILTERS_EXPORT vtkSuperVoxelCut
+  : public vtkUnstructuredGridAlgorithm
+  , protected featuremesh::SuperVoxelCutParameters
+  , protected featuremesh::MultiLabelParameters
 {
 public:
   static vtkSuperVoxelCut* New();
@@ -51,18 +53,18 @@ public:
   vtkGetMacro(Lambda, double);
   /// What the seeds ask for (featuremesh::Task): 0 the one object they lie in (default), 1 every
   /// object like the seeded ones. Out of range: an error at execution.
-  vtkSetMacro(Task, int);
-  vtkGetMacro(Task, int);
+  virtual void SetTask(int value);
+  virtual int GetTask();
   /// What the seeds reach (featuremesh::Connectivity): 0 off, 1 fill holes, 2 one seeded object,
   /// 3 from the task (default: 2 for Object, 1 for Class).
-  vtkSetClampMacro(Connectivity, int, 0, 3);
-  vtkGetMacro(Connectivity, int);
+  virtual void SetConnectivity(int value);
+  virtual int GetConnectivity();
   /// Weight of the seeds' geodesic spatial term for Task Object (featuremesh::SeedGeodesicParameters); 0 = off.
-  vtkSetMacro(GeodesicWeight, double);
-  vtkGetMacro(GeodesicWeight, double);
+  virtual void SetGeodesicWeight(double value);
+  virtual double GetGeodesicWeight();
   /// Length of a voxel of travel in the geodesic, in units of the intensity range.
-  vtkSetMacro(GeodesicLength, double);
-  vtkGetMacro(GeodesicLength, double);
+  virtual void SetGeodesicLength(double value);
+  virtual double GetGeodesicLength();
   /// Kernel bandwidth of the seed histograms as a multiple of Silverman's rule (default 1).
   vtkSetMacro(Bandwidth, double);
   vtkGetMacro(Bandwidth, double);
@@ -94,8 +96,8 @@ public:
   vtkGetCharFromStdStringMacro(SeedLabelArray);
   /// With labelled seeds on a multi-channel image (featuremesh::ChannelModel): 0 one joint density
   /// over the channels (default), 1 the product of one density per channel.
-  vtkSetClampMacro(ChannelModel, int, 0, 1);
-  vtkGetMacro(ChannelModel, int);
+  virtual void SetChannelModel(int value);
+  virtual int GetChannelModel();
   /// Names of labels 0..k, separated by ';' (optional): the outputs' LabelNames field data.
   vtkSetStdStringFromCharMacro(LabelNames);
   vtkGetCharFromStdStringMacro(LabelNames);
@@ -109,22 +111,9 @@ protected:
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  // Defaults: featuremesh::SuperVoxelCutParameters.
-  int Bins;
-  double Sigma;
-  double Lambda;
-  int Task;
-  int Connectivity;
-  double GeodesicWeight;
-  double GeodesicLength;
-  double Bandwidth;
-  bool ScaleByContact;
-  bool VoxelRegionTerm;
-  bool SampleSeedElements;
+  // Output and input options, not the energy's.
   bool SuperVoxelIds = false;
-  double SeedRadius;
-  std::string SeedLabelArray;
-  int ChannelModel;
+  std::string SeedLabelArray = featuremesh::names::Label;
   std::string LabelNames;
 
 private:
