@@ -25,20 +25,50 @@ vtkStandardNewMacro(vtkVoxelCut);
 
 vtkVoxelCut::vtkVoxelCut()
 {
-  const featuremesh::VoxelCutParameters defaults;
-  this->Bins = defaults.Bins;
-  this->Sigma = defaults.Sigma;
-  this->Lambda = defaults.Lambda;
-  this->Task = static_cast<int>(defaults.Task);
-  this->Connectivity = static_cast<int>(defaults.Connectivity);
-  this->GeodesicWeight = defaults.Geodesic.Weight;
-  this->GeodesicLength = defaults.Geodesic.LengthWeight;
-  this->Bandwidth = defaults.Bandwidth;
-  this->SeedRadius = defaults.SeedRadius;
-  this->SeedLabelArray = featuremesh::names::Label;
-  this->ChannelModel = static_cast<int>(featuremesh::MultiLabelParameters().Channels);
   this->SetNumberOfInputPorts(4);
   this->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+}
+
+// Properties whose Core parameter has another name or type.
+void vtkVoxelCut::SetTask(int value)
+{
+  featuremesh::SetParameter(this, this->featuremesh::SeededCutParameters::Task, value);
+}
+int vtkVoxelCut::GetTask()
+{
+  return static_cast<int>(this->featuremesh::SeededCutParameters::Task);
+}
+void vtkVoxelCut::SetConnectivity(int value)
+{
+  featuremesh::SetParameter(this, this->featuremesh::SeededCutParameters::Connectivity, std::min(std::max(value, 0), 3));
+}
+int vtkVoxelCut::GetConnectivity()
+{
+  return static_cast<int>(this->featuremesh::SeededCutParameters::Connectivity);
+}
+void vtkVoxelCut::SetGeodesicWeight(double value)
+{
+  featuremesh::SetParameter(this, this->Geodesic.Weight, value);
+}
+double vtkVoxelCut::GetGeodesicWeight()
+{
+  return this->Geodesic.Weight;
+}
+void vtkVoxelCut::SetGeodesicLength(double value)
+{
+  featuremesh::SetParameter(this, this->Geodesic.LengthWeight, value);
+}
+double vtkVoxelCut::GetGeodesicLength()
+{
+  return this->Geodesic.LengthWeight;
+}
+void vtkVoxelCut::SetChannelModel(int value)
+{
+  featuremesh::SetParameter(this, this->Channels, std::min(std::max(value, 0), 1));
+}
+int vtkVoxelCut::GetChannelModel()
+{
+  return static_cast<int>(this->Channels);
 }
 
 int vtkVoxelCut::FillInputPortInformation(int port, vtkInformation* info)
@@ -94,16 +124,7 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     {
       return fail(error);
     }
-    VoxelCutParameters par;
-    par.Bins = this->Bins;
-    par.Sigma = this->Sigma;
-    par.Lambda = this->Lambda;
-    par.Task = static_cast<featuremesh::Task>(this->Task);
-    par.Connectivity = static_cast<featuremesh::Connectivity>(this->Connectivity);
-    par.Geodesic.Weight = this->GeodesicWeight;
-    par.Geodesic.LengthWeight = this->GeodesicLength;
-    par.Bandwidth = this->Bandwidth;
-    par.SeedRadius = this->SeedRadius;
+    const VoxelCutParameters& par = *this;
     error = ValidateParameters(par);
     if (!error.empty())
     {
@@ -202,8 +223,7 @@ int vtkVoxelCut::RequestMultiLabel(const featuremesh::LabelledSeeds& seeds, vtkD
     return 0;
   }
   this->UpdateProgress(0.2);
-  MultiLabelParameters multi;
-  multi.Channels = static_cast<featuremesh::ChannelModel>(this->ChannelModel);
+  const MultiLabelParameters& multi = *this;
   const MultiLabelResult result =
     MultiLabelVoxelCut(values, bins, geometry, seeds, par, multi, AlgorithmProgress(this, 0.2, 0.95));
   if (result.Aborted)
@@ -229,13 +249,13 @@ void vtkVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Bins: " << this->Bins << "\n"
      << indent << "Sigma: " << this->Sigma << "\n"
      << indent << "Lambda: " << this->Lambda << "\n"
-     << indent << "Task: " << this->Task << "\n"
-     << indent << "Connectivity: " << this->Connectivity << "\n"
-     << indent << "GeodesicWeight: " << this->GeodesicWeight << "\n"
-     << indent << "GeodesicLength: " << this->GeodesicLength << "\n"
+     << indent << "Task: " << this->GetTask() << "\n"
+     << indent << "Connectivity: " << this->GetConnectivity() << "\n"
+     << indent << "GeodesicWeight: " << this->GetGeodesicWeight() << "\n"
+     << indent << "GeodesicLength: " << this->GetGeodesicLength() << "\n"
      << indent << "Bandwidth: " << this->Bandwidth << "\n"
      << indent << "SeedRadius: " << this->SeedRadius << "\n"
      << indent << "SeedLabelArray: " << this->SeedLabelArray << "\n"
-     << indent << "ChannelModel: " << this->ChannelModel << "\n"
+     << indent << "ChannelModel: " << this->GetChannelModel() << "\n"
      << indent << "LabelNames: " << this->LabelNames << "\n";
 }

@@ -12,20 +12,22 @@
 #ifndef vtkVoxelCut_h
 #define vtkVoxelCut_h
 
+#include "Contract.h"
 #include "FeatureMeshFiltersModule.h"
+#include "MultiLabelCut.h" // the parameters, declared once
+#include "SuperVoxelCut.h"
 #include "vtkImageAlgorithm.h"
 
 #include <string>
 
 class vtkDataArray;
-namespace featuremesh
-{
-struct ImageGeometry;
-struct LabelledSeeds;
-struct VoxelCutParameters;
-}
 
-class FEATUREMESHFILTERS_EXPORT vtkVoxelCut : public vtkImageAlgorithm
+// The filter is its Core parameters (TTK's shape): each energy property's value and default live in
+// featuremesh::VoxelCutParameters and MultiLabelParameters, which the setters write.
+class FEATUREMESHFILTERS_EXPORT vtkVoxelCut
+  : public vtkImageAlgorithm
+  , protected featuremesh::VoxelCutParameters
+  , protected featuremesh::MultiLabelParameters
 {
 public:
   static vtkVoxelCut* New();
@@ -43,18 +45,18 @@ public:
   vtkGetMacro(Lambda, double);
   /// What the seeds ask for (featuremesh::Task): 0 the one object they lie in (default), 1 every
   /// object like the seeded ones. Out of range: an error at execution.
-  vtkSetMacro(Task, int);
-  vtkGetMacro(Task, int);
+  virtual void SetTask(int value);
+  virtual int GetTask();
   /// What the seeds reach (featuremesh::Connectivity): 0 off, 1 fill holes, 2 one seeded object,
   /// 3 from the task (default: 2 for Object, 1 for Class).
-  vtkSetClampMacro(Connectivity, int, 0, 3);
-  vtkGetMacro(Connectivity, int);
+  virtual void SetConnectivity(int value);
+  virtual int GetConnectivity();
   /// Weight of the seeds' geodesic spatial term for Task Object (featuremesh::SeedGeodesicParameters); 0 = off.
-  vtkSetMacro(GeodesicWeight, double);
-  vtkGetMacro(GeodesicWeight, double);
+  virtual void SetGeodesicWeight(double value);
+  virtual double GetGeodesicWeight();
   /// Length of a voxel of travel in the geodesic, in units of the intensity range.
-  vtkSetMacro(GeodesicLength, double);
-  vtkGetMacro(GeodesicLength, double);
+  virtual void SetGeodesicLength(double value);
+  virtual double GetGeodesicLength();
   /// Kernel bandwidth of the seed histograms as a multiple of Silverman's rule (default 1).
   vtkSetMacro(Bandwidth, double);
   vtkGetMacro(Bandwidth, double);
@@ -65,8 +67,8 @@ public:
   /// the label names.
   vtkSetStdStringFromCharMacro(SeedLabelArray);
   vtkGetCharFromStdStringMacro(SeedLabelArray);
-  vtkSetClampMacro(ChannelModel, int, 0, 1);
-  vtkGetMacro(ChannelModel, int);
+  virtual void SetChannelModel(int value);
+  virtual int GetChannelModel();
   vtkSetStdStringFromCharMacro(LabelNames);
   vtkGetCharFromStdStringMacro(LabelNames);
 
@@ -81,18 +83,8 @@ protected:
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  // Defaults: featuremesh::VoxelCutParameters.
-  int Bins;
-  double Sigma;
-  double Lambda;
-  int Task;
-  int Connectivity;
-  double GeodesicWeight;
-  double GeodesicLength;
-  double Bandwidth;
-  double SeedRadius;
-  std::string SeedLabelArray;
-  int ChannelModel;
+  // Input and output options, not the energy's.
+  std::string SeedLabelArray = featuremesh::names::Label;
   std::string LabelNames;
 
 private:
