@@ -26,22 +26,21 @@
 
 vtkStandardNewMacro(vtkDelaunayImageMesh);
 
-namespace
-{
-// Beyond this TetGen needs tens of GB and minutes; Feature Nodes places ~0.5 % of the voxels.
-constexpr vtkIdType MaximumNodes = 20000000;
-}
-
 vtkDelaunayImageMesh::vtkDelaunayImageMesh()
 {
-  const featuremesh::DelaunayOptions defaults;
-  this->Backend = static_cast<int>(defaults.Backend);
-  this->QualityRefinement = defaults.QualityRefinement;
-  this->RadiusEdgeRatio = defaults.RadiusEdgeRatio;
-  this->MinDihedralAngle = defaults.MinDihedralAngle;
   this->SetNumberOfInputPorts(2);
   this->SetInputArrayToProcess(
     0, 1, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+}
+
+void vtkDelaunayImageMesh::SetBackend(int backend)
+{
+  featuremesh::SetParameter(this, this->featuremesh::DelaunayOptions::Backend, std::min(std::max(backend, +TETGEN), +CGAL));
+}
+
+int vtkDelaunayImageMesh::GetBackend()
+{
+  return static_cast<int>(this->featuremesh::DelaunayOptions::Backend);
 }
 
 int vtkDelaunayImageMesh::FillInputPortInformation(int port, vtkInformation* info)
@@ -89,12 +88,6 @@ int vtkDelaunayImageMesh::RequestData(
     }
     const bool is2D = geometry.Is2D();
     const vtkIdType nIn = nodes->GetNumberOfPoints();
-    if (nIn < (is2D ? 3 : 4))
-    {
-      vtkErrorMacro("Delaunay Image Mesh: " << nIn << " nodes are too few; a " << (is2D ? "triangle" : "tetrahedral")
-                                            << " mesh needs at least " << (is2D ? 3 : 4) << ".");
-      return 0;
-    }
     // The image is read in its own type (checked as ToDouble would, without the copy).
     vtkDataArray* values = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
     const bool valuesOk = values && CheckDouble(values, error);
@@ -108,65 +101,16 @@ int vtkDelaunayImageMesh::RequestData(
       return 0;
     }
 
-    // Nodes in index space: on voxel centres when Feature Nodes placed them, anywhere else too (the
-    // rasteriser owns each voxel centre exactly whatever the nodes, as after stage 3).
     std::vector<std::array<double, 3>> index = PointsOf(nodes);
-    vtkIdType outside = 0, offPlane = 0;
-    for (auto& p : index)
+    error = ImageMeshNodes(geometry, index);
+    if (error.empty())
     {
-      p = geometry.WorldToIndex(p);
-      bool in = true;
-      for (int a = 0; a < 3; ++a)
-      {
-        in = in && p[a] >= 0.0 && p[a] <= geometry.Dims[a] - 1.0;
-      }
-      outside += in ? 0 : 1;
-      offPlane += (is2D && p[2] != 0.0) ? 1 : 0;
+      error = ValidateParameters(*this, is2D);
     }
-    if (is2D && offPlane)
+    if (!error.empty())
     {
-      vtkErrorMacro("Delaunay Image Mesh: the image is 2D but " << offPlane
-                      << " nodes lie off its slice plane; the nodes do not match the image's dimension.");
+      vtkErrorMacro("Delaunay Image Mesh: " << error);
       return 0;
-    }
-    if (outside)
-    {
-      vtkErrorMacro("Delaunay Image Mesh: " << outside << " of " << nIn << " nodes lie outside the image bounds.");
-      return 0;
-    }
-    if (nIn > MaximumNodes)
-    {
-      vtkErrorMacro("Delaunay Image Mesh: " << nIn << " nodes are more than the " << MaximumNodes
-                                            << " this filter meshes; raise the node spacing in Feature Nodes.");
-      return 0;
-    }
-    const std::int64_t duplicates = CountDuplicates(index);
-    if (duplicates)
-    {
-      vtkErrorMacro("Delaunay Image Mesh: " << duplicates
-                                            << " nodes duplicate other nodes; remove them (e.g. with Clean) first.");
-      return 0;
-    }
-    if (!SpansDimension(index, is2D ? 2 : 3))
-    {
-      vtkErrorMacro("Delaunay Image Mesh: the nodes are " << (is2D ? "collinear" : "coplanar (or collinear)")
-                                                          << "; a mesh needs nodes spanning the image's "
-                                                          << (is2D ? "area." : "volume."));
-      return 0;
-    }
-    // The mesh must tile the box: add the image corners that are not nodes yet.
-    {
-      std::vector<std::array<double, 3>> sorted(index);
-      std::sort(sorted.begin(), sorted.end());
-      for (int c = 0; c < (is2D ? 4 : 8); ++c)
-      {
-        const std::array<double, 3> corner = { { (c & 1) ? geometry.Dims[0] - 1.0 : 0.0,
-          (c & 2) ? geometry.Dims[1] - 1.0 : 0.0, (c & 4) ? geometry.Dims[2] - 1.0 : 0.0 } };
-        if (!std::binary_search(sorted.begin(), sorted.end(), corner))
-        {
-          index.push_back(corner);
-        }
-      }
     }
     const vtkIdType firstSteiner = static_cast<vtkIdType>(index.size());
     this->UpdateProgress(0.1);
@@ -176,20 +120,7 @@ int vtkDelaunayImageMesh::RequestData(
     auto t0 = Clock::now();
     std::vector<std::array<double, 3>> frame(index.size());
     std::transform(index.begin(), index.end(), frame.begin(), [&](const std::array<double, 3>& p) { return geometry.IndexToFrame(p); });
-    DelaunayOptions o;
-    o.Backend = this->Backend == CGAL ? DelaunayBackend::CGAL : DelaunayBackend::TetGen;
-    o.QualityRefinement = this->QualityRefinement;
-    o.RadiusEdgeRatio = this->RadiusEdgeRatio;
-    o.MinDihedralAngle = this->MinDihedralAngle;
-    // TetGen's refinement need not terminate beyond these bounds (its guarantee holds for a ratio of 2
-    // and no angle bound): the liver's nodes never returned with a ratio of 1.0 or an angle of 25.
-    if (!is2D && o.QualityRefinement &&
-      (!(o.RadiusEdgeRatio >= 1.2) || !(o.MinDihedralAngle >= 0.0 && o.MinDihedralAngle <= 18.0)))
-    {
-      vtkErrorMacro("Delaunay Image Mesh: quality refinement needs a radius-edge ratio of at least 1.2 and a minimum "
-                    "dihedral angle in [0, 18] degrees; TetGen may not terminate beyond them.");
-      return 0;
-    }
+    const DelaunayOptions o = *this;
     // TetGen has no progress or abort of its own: it runs on its own thread, owning its input.
     DelaunayResult delaunay;
     if (is2D)
@@ -236,7 +167,7 @@ int vtkDelaunayImageMesh::RequestData(
     PassNodeArrays(nodes->GetPointData(), nIn, output->GetPointData(), nPts, firstSteiner);
 
     AddFieldValue(output, names::AddedNodes, static_cast<double>(nPts - nIn));
-    AddFieldValue(output, names::DelaunayBackend, is2D || this->Backend == CGAL ? 1.0 : 0.0);
+    AddFieldValue(output, names::DelaunayBackend, is2D || this->GetBackend() == CGAL ? 1.0 : 0.0);
     AddFieldValue(output, names::DelaunaySeconds, delaunaySeconds);
     AddFieldValue(output, names::StatisticsSeconds, statisticsSeconds);
     AddFieldValue(output, names::TotalSeconds, std::chrono::duration<double>(Clock::now() - start).count());
@@ -248,7 +179,7 @@ int vtkDelaunayImageMesh::RequestData(
 void vtkDelaunayImageMesh::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "Backend: " << (this->Backend == CGAL ? "CGAL" : "TetGen") << "\n";
+  os << indent << "Backend: " << (this->GetBackend() == CGAL ? "CGAL" : "TetGen") << "\n";
   os << indent << "QualityRefinement: " << this->QualityRefinement << "\n";
   os << indent << "RadiusEdgeRatio: " << this->RadiusEdgeRatio << "\n";
   os << indent << "MinDihedralAngle: " << this->MinDihedralAngle << "\n";

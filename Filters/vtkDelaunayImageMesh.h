@@ -16,10 +16,15 @@
 #ifndef vtkDelaunayImageMesh_h
 #define vtkDelaunayImageMesh_h
 
+#include "DelaunayMesh.h" // the parameters, declared once
 #include "FeatureMeshFiltersModule.h"
 #include "vtkUnstructuredGridAlgorithm.h"
 
-class FEATUREMESHFILTERS_EXPORT vtkDelaunayImageMesh : public vtkUnstructuredGridAlgorithm
+// The filter is its Core parameters (TTK's shape): each property's value and default live in
+// featuremesh::DelaunayOptions, which the setters write.
+class FEATUREMESHFILTERS_EXPORT vtkDelaunayImageMesh
+  : public vtkUnstructuredGridAlgorithm
+  , protected featuremesh::DelaunayOptions
 {
 public:
   static vtkDelaunayImageMesh* New();
@@ -32,8 +37,8 @@ public:
     CGAL = 1
   };
   /// 3D backend: TETGEN (default, as the thesis) or CGAL.
-  vtkSetClampMacro(Backend, int, TETGEN, CGAL);
-  vtkGetMacro(Backend, int);
+  virtual void SetBackend(int backend);
+  virtual int GetBackend();
 
   /// TetGen quality refinement (3D, adds nodes with NodeType 4). Off by default.
   vtkSetMacro(QualityRefinement, bool);
@@ -54,12 +59,6 @@ protected:
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
-
-  // Defaults: featuremesh::DelaunayOptions.
-  int Backend;
-  bool QualityRefinement;
-  double RadiusEdgeRatio;
-  double MinDihedralAngle;
 
 private:
   // The pipeline state of the last failed run (0: none), so that it is not repeated.

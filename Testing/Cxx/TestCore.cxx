@@ -572,6 +572,31 @@ TEST(Tiling, CoarseElementsSpansCoverEveryCentreOnce)
   }
 }
 
+TEST(Delaunay, ImageMeshNodesAreCheckedAndTheBoxCornersAdded)
+{
+  ImageGeometry g;
+  g.Dims = { { 6, 5, 1 } };
+  g.Spacing = { { 2.0, 1.0, 1.0 } };
+  std::vector<std::array<double, 3>> nodes = { { { 0.0, 0.0, 0.0 } }, { { 4.0, 2.0, 0.0 } }, { { 6.0, 1.0, 0.0 } } };
+  EXPECT_EQ(ImageMeshNodes(g, nodes), "");
+  // World to index (x / 2), then the three corners the nodes lack.
+  ASSERT_EQ(nodes.size(), 6u);
+  EXPECT_EQ(nodes[1], (std::array<double, 3>{ { 2.0, 2.0, 0.0 } }));
+  EXPECT_EQ(nodes[3], (std::array<double, 3>{ { 5.0, 0.0, 0.0 } }));
+  EXPECT_EQ(nodes[5], (std::array<double, 3>{ { 5.0, 4.0, 0.0 } }));
+  std::vector<std::array<double, 3>> outside = { { { 0.0, 0.0, 0.0 } }, { { 12.0, 2.0, 0.0 } }, { { 6.0, 3.0, 0.0 } } };
+  EXPECT_EQ(ImageMeshNodes(g, outside), "1 of 3 nodes lie outside the image bounds.");
+  std::vector<std::array<double, 3>> twice = { { { 0.0, 0.0, 0.0 } }, { { 4.0, 2.0, 0.0 } }, { { 4.0, 2.0, 0.0 } } };
+  EXPECT_NE(ImageMeshNodes(g, twice).find("duplicate"), std::string::npos);
+  std::vector<std::array<double, 3>> line = { { { 0.0, 0.0, 0.0 } }, { { 2.0, 1.0, 0.0 } }, { { 4.0, 2.0, 0.0 } } };
+  EXPECT_NE(ImageMeshNodes(g, line).find("collinear"), std::string::npos);
+  DelaunayOptions o;
+  o.QualityRefinement = true;
+  o.MinDihedralAngle = 25.0;
+  EXPECT_FALSE(ValidateParameters(o, false).empty());
+  EXPECT_TRUE(ValidateParameters(o, true).empty());
+}
+
 TEST(Delaunay, DegenerateInputIsAnError)
 {
   std::vector<std::array<double, 3>> line = { { { 0, 0, 0 } }, { { 1, 1, 0 } }, { { 2, 2, 0 } } };

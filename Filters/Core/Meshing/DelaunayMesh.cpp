@@ -441,4 +441,78 @@ DelaunayResult Tetrahedralize(const std::vector<std::array<double, 3>>& points, 
     return r;
   }
 }
+
+std::string ValidateParameters(const DelaunayOptions& o, bool planar)
+{
+  // TetGen's refinement need not terminate beyond these bounds (its guarantee holds for a ratio of 2
+  // and no angle bound): the liver's nodes never returned with a ratio of 1.0 or an angle of 25.
+  if (!planar && o.QualityRefinement &&
+    (!(o.RadiusEdgeRatio >= 1.2) || !(o.MinDihedralAngle >= 0.0 && o.MinDihedralAngle <= 18.0)))
+  {
+    return "quality refinement needs a radius-edge ratio of at least 1.2 and a minimum dihedral angle in [0, 18] "
+           "degrees; TetGen may not terminate beyond them.";
+  }
+  return std::string();
+}
+
+std::string ImageMeshNodes(const ImageGeometry& geometry, std::vector<std::array<double, 3>>& index)
+{
+  const bool is2D = geometry.Is2D();
+  const std::int64_t n = static_cast<std::int64_t>(index.size());
+  if (n < (is2D ? 3 : 4))
+  {
+    return std::to_string(n) + " nodes are too few; a " + (is2D ? "triangle" : "tetrahedral") +
+      " mesh needs at least " + (is2D ? "3" : "4") + ".";
+  }
+  // On voxel centres when Feature Nodes placed them, anywhere else too (the rasteriser owns each
+  // voxel centre exactly whatever the nodes, as after stage 3).
+  std::int64_t outside = 0, offPlane = 0;
+  for (auto& p : index)
+  {
+    p = geometry.WorldToIndex(p);
+    bool in = true;
+    for (int a = 0; a < 3; ++a)
+    {
+      in = in && p[a] >= 0.0 && p[a] <= geometry.Dims[a] - 1.0;
+    }
+    outside += in ? 0 : 1;
+    offPlane += (is2D && p[2] != 0.0) ? 1 : 0;
+  }
+  if (is2D && offPlane)
+  {
+    return "the image is 2D but " + std::to_string(offPlane) +
+      " nodes lie off its slice plane; the nodes do not match the image's dimension.";
+  }
+  if (outside)
+  {
+    return std::to_string(outside) + " of " + std::to_string(n) + " nodes lie outside the image bounds.";
+  }
+  if (n > MaximumImageMeshNodes)
+  {
+    return std::to_string(n) + " nodes are more than the " + std::to_string(MaximumImageMeshNodes) +
+      " this filter meshes; raise the node spacing in Feature Nodes.";
+  }
+  const std::int64_t duplicates = CountDuplicates(index);
+  if (duplicates)
+  {
+    return std::to_string(duplicates) + " nodes duplicate other nodes; remove them (e.g. with Clean) first.";
+  }
+  if (!SpansDimension(index, is2D ? 2 : 3))
+  {
+    return std::string("the nodes are ") + (is2D ? "collinear" : "coplanar (or collinear)") +
+      "; a mesh needs nodes spanning the image's " + (is2D ? "area." : "volume.");
+  }
+  std::vector<std::array<double, 3>> sorted(index);
+  std::sort(sorted.begin(), sorted.end());
+  for (int c = 0; c < (is2D ? 4 : 8); ++c)
+  {
+    const std::array<double, 3> corner = { { (c & 1) ? geometry.Dims[0] - 1.0 : 0.0,
+      (c & 2) ? geometry.Dims[1] - 1.0 : 0.0, (c & 4) ? geometry.Dims[2] - 1.0 : 0.0 } };
+    if (!std::binary_search(sorted.begin(), sorted.end(), corner))
+    {
+      index.push_back(corner);
+    }
+  }
+  return std::string();
+}
 } // namespace featuremesh

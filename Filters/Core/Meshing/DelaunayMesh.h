@@ -2,6 +2,8 @@
 // Library failures (TetGen throws, CGAL asserts by exception) come back as an error sentence.
 #pragma once
 
+#include "ImageGeometry.h"
+
 #include <array>
 #include <cstdint>
 #include <string>
@@ -53,4 +55,18 @@ bool SpansDimension(const std::vector<std::array<double, 3>>& points, int dimens
 
 // Number of points that repeat an earlier point exactly.
 std::int64_t CountDuplicates(const std::vector<std::array<double, 3>>& points);
+
+// Stage 2 (Delaunay Image Mesh) meshes at most this many nodes: beyond, TetGen needs tens of GB and
+// minutes; Feature Nodes places ~0.5 % of the voxels.
+constexpr std::int64_t MaximumImageMeshNodes = 20000000;
+
+// Empty when `options` can mesh an image (`planar`: 2D), else a sentence: 3D quality refinement
+// needs a radius-edge ratio of at least 1.2 and a dihedral bound in [0, 18] degrees.
+std::string ValidateParameters(const DelaunayOptions& options, bool planar);
+
+// Stage 2's nodes: `points` (world coordinates) into the image's index space, checked (enough of
+// them, inside the image, on its plane in 2D, at most MaximumImageMeshNodes, no duplicates,
+// spanning its area or volume) and followed by the box corners they lack, so that the mesh tiles
+// the box. Empty when usable, else a sentence.
+std::string ImageMeshNodes(const ImageGeometry& geometry, std::vector<std::array<double, 3>>& points);
 } // namespace featuremesh
