@@ -176,6 +176,11 @@ int vtkDelaunayImageMesh::RequestData(
   });
 }
 
+std::string vtkDelaunayImageMesh::ValidateProperties()
+{
+  return featuremesh::ValidateParameters(static_cast<const featuremesh::DelaunayOptions&>(*this), false);
+}
+
 void vtkDelaunayImageMesh::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);

@@ -30,6 +30,9 @@ public:
   static vtkDelaunayImageMesh* New();
   vtkTypeMacro(vtkDelaunayImageMesh, vtkUnstructuredGridAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
+  /// Empty when the properties are usable, else the sentence Apply would fail with (3D bounds:
+  /// a 2D image takes any refinement bound).
+  std::string ValidateProperties();
 
   enum Backends
   {

@@ -100,7 +100,7 @@ int vtkFeatureNodes::Execute(vtkInformationVector** inputVector, vtkInformationV
     return 0;
   }
   const FeatureNodeParameters& p = *this;
-  error = ValidateParameters(p);
+  error = this->ValidateProperties();
   if (!error.empty())
   {
     vtkErrorMacro("Feature Nodes: " << error);
@@ -228,6 +228,11 @@ int vtkFeatureNodes::Execute(vtkInformationVector** inputVector, vtkInformationV
   edgeOutput->GetPointData()->SetScalars(edgeArray);
   this->UpdateProgress(1.0);
   return 1;
+}
+
+std::string vtkFeatureNodes::ValidateProperties()
+{
+  return featuremesh::ValidateParameters(static_cast<const featuremesh::FeatureNodeParameters&>(*this));
 }
 
 void vtkFeatureNodes::PrintSelf(ostream& os, vtkIndent indent)

@@ -33,6 +33,8 @@ public:
   static vtkFeatureNodes* New();
   vtkTypeMacro(vtkFeatureNodes, vtkPolyDataAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
+  /// Empty when the properties are usable, else the sentence Apply would fail with.
+  std::string ValidateProperties();
 
   /// Standard deviation (voxels) of the Gaussian applied before Canny. Default 0.7.
   vtkSetMacro(GaussianSigma, double);

@@ -80,7 +80,7 @@ int vtkImageMeshSmoothing::RequestData(
     };
 
     const MeshSmoothingParameters& par = *this;
-    error = ValidateParameters(par);
+    error = this->ValidateProperties();
     if (!error.empty())
     {
       return fail(error);
@@ -191,6 +191,11 @@ int vtkImageMeshSmoothing::RequestData(
     this->UpdateProgress(1.0);
     return 1;
   });
+}
+
+std::string vtkImageMeshSmoothing::ValidateProperties()
+{
+  return featuremesh::ValidateParameters(static_cast<const featuremesh::MeshSmoothingParameters&>(*this));
 }
 
 void vtkImageMeshSmoothing::PrintSelf(ostream& os, vtkIndent indent)

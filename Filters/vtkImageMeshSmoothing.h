@@ -32,6 +32,8 @@ public:
   static vtkImageMeshSmoothing* New();
   vtkTypeMacro(vtkImageMeshSmoothing, vtkUnstructuredGridAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
+  /// Empty when the properties are usable, else the sentence Apply would fail with.
+  std::string ValidateProperties();
 
   enum Methods
   {

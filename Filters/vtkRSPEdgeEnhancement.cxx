@@ -136,7 +136,7 @@ int vtkRSPEdgeEnhancement::RequestData(vtkInformation*, vtkInformationVector** i
       return fail(error);
     }
     const RSPParameters& p = *this;
-    error = ValidateParameters(p);
+    error = this->ValidateProperties();
     if (!error.empty())
     {
       return fail(error);
@@ -247,6 +247,11 @@ int vtkRSPEdgeEnhancement::RequestData(vtkInformation*, vtkInformationVector** i
     this->UpdateProgress(1.0);
     return 1;
   });
+}
+
+std::string vtkRSPEdgeEnhancement::ValidateProperties()
+{
+  return featuremesh::ValidateParameters(static_cast<const featuremesh::RSPParameters&>(*this));
 }
 
 void vtkRSPEdgeEnhancement::PrintSelf(ostream& os, vtkIndent indent)

@@ -28,6 +28,8 @@ public:
   static vtkRSPEdgeEnhancement* New();
   vtkTypeMacro(vtkRSPEdgeEnhancement, vtkImageAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
+  /// Empty when the properties are usable, else the sentence Apply would fail with.
+  std::string ValidateProperties();
 
   /// beta of G = exp(-beta |grad I|), |grad I| in 8-bit grey levels per voxel (the image's 1st-99th
   /// percentile range mapped to 255). Default 0.1, the thesis's.

@@ -73,7 +73,7 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
     };
 
     const SurfaceSmoothingParameters& par = *this;
-    error = ValidateParameters(par);
+    error = this->ValidateProperties();
     if (!error.empty())
     {
       return fail(error);
@@ -216,6 +216,11 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
     this->UpdateProgress(1.0);
     return 1;
   });
+}
+
+std::string vtkSegmentationSurfaceSmoothing::ValidateProperties()
+{
+  return featuremesh::ValidateParameters(static_cast<const featuremesh::SurfaceSmoothingParameters&>(*this));
 }
 
 void vtkSegmentationSurfaceSmoothing::PrintSelf(ostream& os, vtkIndent indent)

@@ -30,6 +30,8 @@ public:
   static vtkSegmentationSurfaceSmoothing* New();
   vtkTypeMacro(vtkSegmentationSurfaceSmoothing, vtkPolyDataAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
+  /// Empty when the properties are usable, else the sentence Apply would fail with.
+  std::string ValidateProperties();
 
   enum Methods
   {

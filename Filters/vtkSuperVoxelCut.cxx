@@ -183,7 +183,7 @@ int vtkSuperVoxelCut::RequestData(
     };
 
     const SuperVoxelCutParameters& par = *this;
-    error = ValidateParameters(par);
+    error = this->ValidateProperties();
     if (!error.empty())
     {
       return fail(error);
@@ -481,6 +481,11 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
   }
   this->UpdateProgress(1.0);
   return 1;
+}
+
+std::string vtkSuperVoxelCut::ValidateProperties()
+{
+  return featuremesh::ValidateParameters(static_cast<const featuremesh::SuperVoxelCutParameters&>(*this));
 }
 
 void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)

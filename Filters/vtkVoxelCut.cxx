@@ -125,7 +125,7 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
       return fail(error);
     }
     const VoxelCutParameters& par = *this;
-    error = ValidateParameters(par);
+    error = this->ValidateProperties();
     if (!error.empty())
     {
       return fail(error);
@@ -241,6 +241,11 @@ int vtkVoxelCut::RequestMultiLabel(const featuremesh::LabelledSeeds& seeds, vtkD
   AddFieldValue(output, names::TotalSeconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   this->UpdateProgress(1.0);
   return 1;
+}
+
+std::string vtkVoxelCut::ValidateProperties()
+{
+  return featuremesh::ValidateParameters(static_cast<const featuremesh::VoxelCutParameters&>(*this));
 }
 
 void vtkVoxelCut::PrintSelf(ostream& os, vtkIndent indent)

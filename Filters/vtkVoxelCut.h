@@ -33,6 +33,8 @@ public:
   static vtkVoxelCut* New();
   vtkTypeMacro(vtkVoxelCut, vtkImageAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
+  /// Empty when the properties are usable, else the sentence Apply would fail with.
+  std::string ValidateProperties();
 
   /// Histogram bins; 0 = automatic (64).
   vtkSetMacro(Bins, int);

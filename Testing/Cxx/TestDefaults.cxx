@@ -1,5 +1,7 @@
 // Every numeric property default in the plugin's XML equals the default of the VTK filter it sets
-// (which the filters take from the Core parameter structs): one source of truth, checked.
+// (which the filters take from the Core parameter structs): one source of truth, checked. And every
+// value an XML domain offers (range ends, enumeration entries) passes the filter's
+// ValidateProperties, the Core's ValidateParameters: the two range checks agree.
 #include "vtkDelaunayImageMesh.h"
 #include "vtkImageMeshSmoothing.h"
 #include "vtkFeatureNodes.h"
@@ -20,13 +22,26 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
+
+// A numeric property: its default, and what the filter's ValidateProperties says of a value.
+struct Property
+{
+  std::function<double()> Default;
+  std::function<std::string(double)> Check;
+};
 
 #define GETTER(cls, name)                                                                          \
   {                                                                                                \
-    #cls "::" #name, []() {                                                                        \
-      vtkNew<cls> filter;                                                                          \
-      return static_cast<double>(filter->Get##name());                                             \
-    }                                                                                              \
+    #cls "::" #name, Property{ []() {                                                              \
+                                vtkNew<cls> filter;                                                \
+                                return static_cast<double>(filter->Get##name());                   \
+                              },                                                                   \
+      [](double value) {                                                                           \
+        vtkNew<cls> filter;                                                                        \
+        filter->Set##name(static_cast<decltype(filter->Get##name())>(value));                      \
+        return filter->ValidateProperties();                                                       \
+      } }                                                                                          \
   }
 
 #define STRING_GETTER(cls, name)                                                                   \
@@ -45,7 +60,7 @@ int main(int argc, char* argv[])
     std::cerr << "usage: FeatureMeshDefaultsTest PLUGIN_DIR\n";
     return 2;
   }
-  const std::map<std::string, std::function<double()>> getters = {
+  const std::map<std::string, Property> getters = {
     GETTER(vtkFeatureNodes, GaussianSigma), GETTER(vtkFeatureNodes, HessianSigma),
     GETTER(vtkFeatureNodes, LowThreshold), GETTER(vtkFeatureNodes, HighThreshold),
     GETTER(vtkFeatureNodes, MaximumPercentile), GETTER(vtkFeatureNodes, CovarianceNeighbourhood),
@@ -88,7 +103,7 @@ int main(int argc, char* argv[])
     STRING_GETTER(vtkSuperVoxelCut, SeedLabelArray), STRING_GETTER(vtkSuperVoxelCut, LabelNames),
     STRING_GETTER(vtkVoxelCut, SeedLabelArray), STRING_GETTER(vtkVoxelCut, LabelNames),
   };
-  int failures = 0, checked = 0;
+  int failures = 0, checked = 0, ranges = 0;
   std::set<std::string> seen;
   for (const char* file : { "FeatureNodes.xml", "DelaunayImageMesh.xml", "ImageMeshSmoothing.xml", "RSPEdgeEnhancement.xml",
          "SuperVoxelCut.xml", "SegmentationSurfaceSmoothing.xml" })
@@ -140,9 +155,52 @@ int main(int argc, char* argv[])
           ++failures;
           continue;
         }
+        // Every value the XML's domain offers (range ends, enumeration entries) must pass the Core's
+        // ValidateParameters, alone at the other defaults.
+        for (int d = 0; d < property->GetNumberOfNestedElements(); ++d)
+        {
+          vtkXMLDataElement* domain = property->GetNestedElement(d);
+          const std::string kind = domain->GetName();
+          std::vector<std::string> offered;
+          if (kind == "IntRangeDomain" || kind == "DoubleRangeDomain")
+          {
+            for (const char* end : { "min", "max" })
+            {
+              if (domain->GetAttribute(end))
+                offered.emplace_back(domain->GetAttribute(end));
+            }
+          }
+          if (kind == "EnumerationDomain" || kind == "BooleanDomain")
+          {
+            for (int e = 0; e < domain->GetNumberOfNestedElements(); ++e)
+            {
+              if (domain->GetNestedElement(e)->GetAttribute("value"))
+                offered.emplace_back(domain->GetNestedElement(e)->GetAttribute("value"));
+            }
+            if (kind == "BooleanDomain")
+              offered = { "0", "1" };
+          }
+          for (const std::string& text : offered)
+          {
+            // A bound between two properties, not a range: the low threshold may reach 1 when the
+            // high one does, and the high one fall to 0.01 when the low one does.
+            if ((key == "vtkFeatureNodes::LowThreshold" && text == "1") ||
+              (key == "vtkFeatureNodes::HighThreshold" && text == "0.01"))
+              continue;
+            double v = 0.0;
+            std::istringstream(text) >> v;
+            const std::string why = it->second.Check(v);
+            ++ranges;
+            if (!why.empty())
+            {
+              std::cout << "FAIL: " << key << ": the XML offers " << text << ", which the filter refuses: " << why << "\n";
+              ++failures;
+            }
+          }
+        }
         double xml = 0.0;
         std::istringstream(value) >> xml;
-        const double cxx = it->second();
+        const double cxx = it->second.Default();
         ++checked;
         if (xml != cxx)
         {
@@ -169,6 +227,6 @@ int main(int argc, char* argv[])
       ++failures;
     }
   }
-  std::cout << checked << " defaults checked, " << failures << " failures\n";
+  std::cout << checked << " defaults and " << ranges << " domain values checked, " << failures << " failures\n";
   return failures ? EXIT_FAILURE : EXIT_SUCCESS;
 }
