@@ -35,7 +35,7 @@ vtkDelaunayImageMesh::vtkDelaunayImageMesh()
 
 void vtkDelaunayImageMesh::SetBackend(int backend)
 {
-  featuremesh::SetParameter(this, this->featuremesh::DelaunayOptions::Backend, std::min(std::max(backend, +TETGEN), +CGAL));
+  featuremesh::SetClampedParameter(this, this->featuremesh::DelaunayOptions::Backend, backend, TETGEN, CGAL);
 }
 
 int vtkDelaunayImageMesh::GetBackend()

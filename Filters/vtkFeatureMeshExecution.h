@@ -35,6 +35,31 @@ void SetParameter(vtkObject* filter, Parameter& parameter, Value value)
   }
 }
 
+// SetParameter of an enumeration property, clamped to [low, high] as vtkSetClampMacro does.
+template <typename Parameter>
+void SetClampedParameter(vtkObject* filter, Parameter& parameter, int value, int low, int high)
+{
+  SetParameter(filter, parameter, value < low ? low : (value > high ? high : value));
+}
+
+// The accessors of the properties whose Core field has another name or type, which both seeded cuts
+// (vtkSuperVoxelCut, vtkVoxelCut: featuremesh::SeededCutParameters and MultiLabelParameters)
+// declare; defined once here, expanded in each cut's .cxx.
+#define FEATUREMESH_SEEDED_CUT_ACCESSORS(cls)                                                                      \
+  void cls::SetTask(int value) { featuremesh::SetParameter(this, this->featuremesh::SeededCutParameters::Task, value); } \
+  int cls::GetTask() { return static_cast<int>(this->featuremesh::SeededCutParameters::Task); }                    \
+  void cls::SetConnectivity(int value)                                                                             \
+  {                                                                                                                \
+    featuremesh::SetClampedParameter(this, this->featuremesh::SeededCutParameters::Connectivity, value, 0, 3);    \
+  }                                                                                                                \
+  int cls::GetConnectivity() { return static_cast<int>(this->featuremesh::SeededCutParameters::Connectivity); }    \
+  void cls::SetGeodesicWeight(double value) { featuremesh::SetParameter(this, this->Geodesic.Weight, value); }     \
+  double cls::GetGeodesicWeight() { return this->Geodesic.Weight; }                                                \
+  void cls::SetGeodesicLength(double value) { featuremesh::SetParameter(this, this->Geodesic.LengthWeight, value); } \
+  double cls::GetGeodesicLength() { return this->Geodesic.LengthWeight; }                                          \
+  void cls::SetChannelModel(int value) { featuremesh::SetClampedParameter(this, this->Channels, value, 0, 1); }    \
+  int cls::GetChannelModel() { return static_cast<int>(this->Channels); }
+
 // What a run depends on: the newest modification of the filter or of anything upstream, and the
 // requested time step (a time series changes the data, not the modification times).
 struct RunState

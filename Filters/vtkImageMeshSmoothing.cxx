@@ -27,12 +27,7 @@ vtkImageMeshSmoothing::vtkImageMeshSmoothing()
 
 void vtkImageMeshSmoothing::SetMethod(int method)
 {
-  const auto m = static_cast<featuremesh::SmoothingMethod>(std::min(std::max(method, +CVT), +ODT));
-  if (m != this->Method)
-  {
-    this->Method = m;
-    this->Modified();
-  }
+  featuremesh::SetClampedParameter(this, this->Method, method, CVT, ODT);
 }
 
 int vtkImageMeshSmoothing::GetMethod()

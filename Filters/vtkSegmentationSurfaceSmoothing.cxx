@@ -31,12 +31,7 @@ vtkSegmentationSurfaceSmoothing::vtkSegmentationSurfaceSmoothing()
 
 void vtkSegmentationSurfaceSmoothing::SetMethod(int method)
 {
-  const auto m = static_cast<featuremesh::SurfaceSmoothingMethod>(std::min(std::max(method, +LAPLACIAN), +TAUBIN));
-  if (m != this->Method)
-  {
-    this->Method = m;
-    this->Modified();
-  }
+  featuremesh::SetClampedParameter(this, this->Method, method, LAPLACIAN, TAUBIN);
 }
 
 int vtkSegmentationSurfaceSmoothing::GetMethod()

@@ -73,47 +73,7 @@ vtkSuperVoxelCut::vtkSuperVoxelCut()
   this->SetInputArrayToProcess(0, 3, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
 }
 
-// Properties whose Core parameter has another name or type.
-void vtkSuperVoxelCut::SetTask(int value)
-{
-  featuremesh::SetParameter(this, this->featuremesh::SeededCutParameters::Task, value);
-}
-int vtkSuperVoxelCut::GetTask()
-{
-  return static_cast<int>(this->featuremesh::SeededCutParameters::Task);
-}
-void vtkSuperVoxelCut::SetConnectivity(int value)
-{
-  featuremesh::SetParameter(this, this->featuremesh::SeededCutParameters::Connectivity, std::min(std::max(value, 0), 3));
-}
-int vtkSuperVoxelCut::GetConnectivity()
-{
-  return static_cast<int>(this->featuremesh::SeededCutParameters::Connectivity);
-}
-void vtkSuperVoxelCut::SetGeodesicWeight(double value)
-{
-  featuremesh::SetParameter(this, this->Geodesic.Weight, value);
-}
-double vtkSuperVoxelCut::GetGeodesicWeight()
-{
-  return this->Geodesic.Weight;
-}
-void vtkSuperVoxelCut::SetGeodesicLength(double value)
-{
-  featuremesh::SetParameter(this, this->Geodesic.LengthWeight, value);
-}
-double vtkSuperVoxelCut::GetGeodesicLength()
-{
-  return this->Geodesic.LengthWeight;
-}
-void vtkSuperVoxelCut::SetChannelModel(int value)
-{
-  featuremesh::SetParameter(this, this->Channels, std::min(std::max(value, 0), 1));
-}
-int vtkSuperVoxelCut::GetChannelModel()
-{
-  return static_cast<int>(this->Channels);
-}
+FEATUREMESH_SEEDED_CUT_ACCESSORS(vtkSuperVoxelCut)
 
 int vtkSuperVoxelCut::FillInputPortInformation(int port, vtkInformation* info)
 {

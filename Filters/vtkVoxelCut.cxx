@@ -29,47 +29,7 @@ vtkVoxelCut::vtkVoxelCut()
   this->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
 }
 
-// Properties whose Core parameter has another name or type.
-void vtkVoxelCut::SetTask(int value)
-{
-  featuremesh::SetParameter(this, this->featuremesh::SeededCutParameters::Task, value);
-}
-int vtkVoxelCut::GetTask()
-{
-  return static_cast<int>(this->featuremesh::SeededCutParameters::Task);
-}
-void vtkVoxelCut::SetConnectivity(int value)
-{
-  featuremesh::SetParameter(this, this->featuremesh::SeededCutParameters::Connectivity, std::min(std::max(value, 0), 3));
-}
-int vtkVoxelCut::GetConnectivity()
-{
-  return static_cast<int>(this->featuremesh::SeededCutParameters::Connectivity);
-}
-void vtkVoxelCut::SetGeodesicWeight(double value)
-{
-  featuremesh::SetParameter(this, this->Geodesic.Weight, value);
-}
-double vtkVoxelCut::GetGeodesicWeight()
-{
-  return this->Geodesic.Weight;
-}
-void vtkVoxelCut::SetGeodesicLength(double value)
-{
-  featuremesh::SetParameter(this, this->Geodesic.LengthWeight, value);
-}
-double vtkVoxelCut::GetGeodesicLength()
-{
-  return this->Geodesic.LengthWeight;
-}
-void vtkVoxelCut::SetChannelModel(int value)
-{
-  featuremesh::SetParameter(this, this->Channels, std::min(std::max(value, 0), 1));
-}
-int vtkVoxelCut::GetChannelModel()
-{
-  return static_cast<int>(this->Channels);
-}
+FEATUREMESH_SEEDED_CUT_ACCESSORS(vtkVoxelCut)
 
 int vtkVoxelCut::FillInputPortInformation(int port, vtkInformation* info)
 {
