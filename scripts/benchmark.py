@@ -137,7 +137,7 @@ def run_case(case, args):
     q0 = metrics.mesh_quality(v2n(raw.GetPoints().GetData()), cells_of(raw))
     q1 = metrics.mesh_quality(v2n(labelled.GetPoints().GetData()), cells_of(labelled))
     row = {"case": case.name, "voxels": T.size, "elements": labelled.GetNumberOfCells(),
-           "elements_with_voxels": int((v2n(labelled.GetCellData().GetArray("PixelCount")) > 0).sum()),
+           "elements_with_voxels": int((v2n(labelled.GetCellData().GetArray(fm.names.PixelCount)) > 0).sum()),
            "nodes_s": med["nodes"], "mesh_s": med["mesh"], "smoothing_s": med["smoothing"], "cut_s": med["cut"], "total_s": total,
            "voxel_cut_s": statistics.median(vt), "speedup": statistics.median(vt) / total,
            "recut_s": statistics.median(rt), "recut_speedup": statistics.median(vt) / statistics.median(rt),
@@ -161,7 +161,7 @@ def run_case(case, args):
                 row["random_walker_scale"] = scale
     if not args.no_slic:
         ids = case.super_voxel_cut(mesh, SuperVoxelIds=1)
-        owner = v2n(fm.fetch(ids, 2).GetPointData().GetArray("ElementId")).reshape(shape)
+        owner = v2n(fm.fetch(ids, 2).GetPointData().GetArray(fm.names.ElementId)).reshape(shape)
         owner = np.where(owner < 0, owner.max() + 1, owner)
         mine = metrics.partition_scores(owner, truth)
         ps.Delete(ids)

@@ -137,7 +137,7 @@ def run_case(name, folder, args, tmp):
     cut.UpdatePipeline()
     out["seconds"]["supervoxel"] = time.perf_counter() - t
     result = fm.labels(cut)
-    ids = fm.v2n(fm.fetch(cut, 2).GetPointData().GetArray("ElementId"))
+    ids = fm.v2n(fm.fetch(cut, 2).GetPointData().GetArray(fm.names.ElementId))
     out["elements"] = int(ids.max()) + 1
     out["dice"]["supervoxel"] = per_label_dice(result, truth, k)
     out["dice"]["oracle"] = per_label_dice(oracle(ids, truth, k), truth, k)

@@ -43,7 +43,7 @@ def main():
             walls.append(time.perf_counter() - t0)
             out = sm.Fetch(nodes)
             count = out.GetNumberOfPoints()
-            field = out.GetFieldData().GetArray("StepSeconds")
+            field = out.GetFieldData().GetArray(fm.names.StepSeconds)
             for c in range(field.GetNumberOfComponents()):
                 key = field.GetComponentName(c)
                 times.setdefault(key, []).append(field.GetComponent(0, c))

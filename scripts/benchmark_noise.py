@@ -55,8 +55,8 @@ def run(case, source, truth, floor):
         proxy.UpdatePipeline()
     seconds = time.perf_counter() - t
     n = fm.fetch(nodes)
-    counts = fm.v2n(n.GetFieldData().GetArray("NodeCounts")).ravel()
-    row = {"floor": int(floor), "estimated_sigma": float(fm.v2n(n.GetFieldData().GetArray("NoiseSigma"))[0]),
+    counts = fm.v2n(n.GetFieldData().GetArray(fm.names.NodeCounts)).ravel()
+    row = {"floor": int(floor), "estimated_sigma": float(fm.v2n(n.GetFieldData().GetArray(fm.names.NoiseSigma))[0]),
            "nodes": int(n.GetNumberOfPoints()), "canny": int(counts[0]), "halftone": int(counts[1]),
            "elements": int(fm.fetch(smoothed).GetNumberOfCells()), "seconds": seconds,
            "dice_supervoxel": fm.dice(fm.labels(cut), truth)}

@@ -57,7 +57,7 @@ def mesh_scores(case, edges, truth, shape, nodes_props):
     mesh = case.smoothing(case.mesh(nodes))
     cut = case.super_voxel_cut(mesh)
     ids = case.super_voxel_cut(mesh, SuperVoxelIds=1)
-    owner = v2n(fm.fetch(ids, 2).GetPointData().GetArray("ElementId")).reshape(shape)
+    owner = v2n(fm.fetch(ids, 2).GetPointData().GetArray(fm.names.ElementId)).reshape(shape)
     owner = np.where(owner < 0, owner.max() + 1, owner)
     scores = metrics.partition_scores(owner, truth)
     out = {"elements": fm.fetch(mesh).GetNumberOfCells(), "K": scores["K"], "oracle": scores["oracle_dice"],
@@ -76,12 +76,12 @@ def run_case(case, args):
         rsp = case.rsp(**parse(args.rsp))
         seconds.append(timed(rsp))
     out = fm.fetch(rsp)
-    ec = v2n(out.GetPointData().GetArray("EdgeConfidence")).reshape(shape)
+    ec = v2n(out.GetPointData().GetArray(fm.names.EdgeConfidence)).reshape(shape)
     ratio, near, far = (float(v) for v in ec_ratio(ec, truth))
     fd = out.GetFieldData()
-    row = {"case": case.name, "rsp_s": statistics.median(seconds), "path_grid": int(fd.GetArray("PathGridFactor").GetValue(0)),
+    row = {"case": case.name, "rsp_s": statistics.median(seconds), "path_grid": int(fd.GetArray(fm.names.PathGridFactor).GetValue(0)),
            "ec_ratio": ratio, "ec_near": near, "ec_far": far,
-           "edge_voxels": int(v2n(out.GetPointData().GetArray("EdgeMap")).sum())}
+           "edge_voxels": int(v2n(out.GetPointData().GetArray(fm.names.EdgeMap)).sum())}
     canny = mesh_scores(case, None, truth, shape, {})
     seeded = mesh_scores(case, rsp, truth, shape, parse(args.nodes))
     row.update({"elements_canny": canny["elements"], "elements_rsp": seeded["elements"],

@@ -33,7 +33,7 @@ def quality(mesh):
 
 def scores(case, mesh, truth, T):
     cut = case.super_voxel_cut(mesh, SuperVoxelIds=1)
-    owner = v2n(fm.fetch(cut, 2).GetPointData().GetArray("ElementId")).reshape(truth.shape)
+    owner = v2n(fm.fetch(cut, 2).GetPointData().GetArray(fm.names.ElementId)).reshape(truth.shape)
     dice = fm.dice(fm.labels(cut), T)
     part = metrics.partition_scores(owner, truth)
     ps.Delete(cut)
@@ -79,16 +79,16 @@ def main():
         d1, o1 = scores(case, smoothed, truth, T)
         fd = m1.GetFieldData()
         row = {"case": name, "nodes": m0.GetNumberOfPoints(),
-               "added_pct": 100.0 * fd.GetArray("AddedNodes").GetValue(0) / m0.GetNumberOfPoints(),
+               "added_pct": 100.0 * fd.GetArray(fm.names.AddedNodes).GetValue(0) / m0.GetNumberOfPoints(),
                "elements_before": m0.GetNumberOfCells(), "elements_after": m1.GetNumberOfCells(),
                "min_before": q0["min"], "min_after": q1["min"], "p1_before": q0["p1"], "p1_after": q1["p1"],
                "max_before": q0["max"], "max_after": q1["max"],
                "dice_before": d0, "dice_after": d1, "oracle_before": o0, "oracle_after": o1,
-               "empty_before_pct": 100.0 * (v2n(m0.GetCellData().GetArray("PixelCount")) == 0).mean(),
-               "empty_after_pct": 100.0 * (v2n(m1.GetCellData().GetArray("PixelCount")) == 0).mean(),
+               "empty_before_pct": 100.0 * (v2n(m0.GetCellData().GetArray(fm.names.PixelCount)) == 0).mean(),
+               "empty_after_pct": 100.0 * (v2n(m1.GetCellData().GetArray(fm.names.PixelCount)) == 0).mean(),
                "smoothing_s": statistics.median(seconds),
-               "sweeps_s": fd.GetArray("SweepSeconds").GetValue(0),
-               "refinement_s": fd.GetArray("RefinementSeconds").GetValue(0)}
+               "sweeps_s": fd.GetArray(fm.names.SweepSeconds).GetValue(0),
+               "refinement_s": fd.GetArray(fm.names.RefinementSeconds).GetValue(0)}
         rows.append(row)
         print(" | ".join("%s %s" % (k, ("%.3f" % v) if isinstance(v, float) else v) for k, v in row.items()), flush=True)
     keys = list(rows[0].keys()) if rows else []

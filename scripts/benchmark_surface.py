@@ -81,7 +81,7 @@ def main():
                     volume_change_pct=round(100 * field(out, "MeasureChange"), 2),
                     short_nodes="%d/%d" % (field(out, "ShortNodes"), field(out, "BoundaryNodes")),
                     reached=round(field(out, "ReachedFraction"), 3),
-                    min_dihedral=round(float(v2n(mesh.GetCellData().GetArray("MinDihedralAngle")).min()), 2),
+                    min_dihedral=round(float(v2n(mesh.GetCellData().GetArray(fm.names.MinDihedralAngle)).min()), 2),
                     seconds=round(statistics.median(seconds), 3), surface_seconds=round(statistics.median(surface_s), 4),
                     volume_seconds=round(statistics.median(volume_s), 3))
                 ps.Delete(smooth)

@@ -18,8 +18,9 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import featuremesh as fm  # noqa: E402
 
 # Cell arrays by value, in a fixed order; the quality array was once called Quality.
-CELL_ARRAYS = ("PixelCount", "MeanIntensity", "IntensityStdDev", "Interpolated", ("MinAngle", "MinDihedralAngle", "Quality"),
-               "RadiusRatio")
+N = fm.names
+CELL_ARRAYS = (N.PixelCount, N.MeanIntensity, N.IntensityStdDev, N.Interpolated, (N.MinAngle, N.MinDihedralAngle, "Quality"),
+               N.RadiusRatio)
 
 
 def sha(*arrays):
@@ -57,7 +58,7 @@ def main():
         nodes = case.feature_nodes()
         n = fm.fetch(nodes)
         lines.append("%s nodes %s" % (name, sha(fm.v2n(n.GetPoints().GetData()),
-                                               *[fm.v2n(n.GetPointData().GetArray(a)) for a in ("NodeType", "Fixed", "SampleRadius")])))
+                                               *[fm.v2n(n.GetPointData().GetArray(a)) for a in (N.NodeType, N.Fixed, N.SampleRadius)])))
         for backend in ([0, 1] if case.is3d else [0]):
             mesh = case.mesh(nodes, Backend=backend)
             m = fm.fetch(mesh)
@@ -66,7 +67,7 @@ def main():
                                                   *[cell_array(m, a) for a in CELL_ARRAYS])))
             lines.append("%s mesh owners %s" % (tag, owners(mesh)))
             cut = case.super_voxel_cut(mesh, **cut_properties)
-            lines.append("%s labels %s" % (tag, sha(fm.v2n(fm.fetch(cut, 0).GetCellData().GetArray("Label")),
+            lines.append("%s labels %s" % (tag, sha(fm.v2n(fm.fetch(cut, 0).GetCellData().GetArray(N.Label)),
                                                     fm.v2n(fm.fetch(cut, 2).GetPointData().GetScalars()))))
             surface = case.surface_smoothing(cut)
             f0, f1 = fm.fetch(surface, 0), fm.fetch(surface, 1)

@@ -152,7 +152,7 @@ def main():
     smoothing = {sfd.GetArrayName(i): sfd.GetArray(i).GetValue(0) for i in range(sfd.GetNumberOfArrays())
                  if sfd.GetArray(i).GetNumberOfTuples() == 1}
     field = {fd.GetArrayName(i): fd.GetArray(i).GetValue(0) for i in range(fd.GetNumberOfArrays()) if fd.GetArray(i) is not None}
-    quality = v2n(labelled.GetCellData().GetArray("MinAngle") or labelled.GetCellData().GetArray("MinDihedralAngle"))
+    quality = v2n(labelled.GetCellData().GetArray(fm.names.MinAngle) or labelled.GetCellData().GetArray(fm.names.MinDihedralAngle))
     raw = sm.Fetch(delaunay)
     angles = {"delaunay": metrics.mesh_quality(v2n(raw.GetPoints().GetData()), cells_of(raw)),
               "final": metrics.mesh_quality(v2n(labelled.GetPoints().GetData()), cells_of(labelled))}
@@ -162,16 +162,16 @@ def main():
               # Minimum, 1st percentile of the element minima, maximum: angles (2D) or dihedral angles (3D).
               "angles_degrees": angles, "smoothing": not args.no_smoothing, "rsp": args.rsp,
               "added_nodes": int(field.get("AddedNodes", 0)) if not args.no_smoothing else 0,
-              "object_elements": int((v2n(labelled.GetCellData().GetArray("Label")) > 0).sum()),
+              "object_elements": int((v2n(labelled.GetCellData().GetArray(fm.names.Label)) > 0).sum()),
               "task": cut.GetProperty("Task").GetData(), "lambda": float(cut.Lambda),
               "connectivity": cut.GetProperty("Connectivity").GetData(),
               "sigma": field.get("Sigma"), "flow": field.get("Flow"),
-              "labels": int(field.get("Labels", 2)), "expansion_moves": field.get("ExpansionMoves"),
+              "labels": int(field.get(fm.names.Labels, 2)), "expansion_moves": field.get(fm.names.ExpansionMoves),
               "energy": field.get("Energy"),
               "object_components": int(field.get("ObjectComponents", 0)),
               # World units (the image spacing's unit, squared in 2D, cubed in 3D), largest first.
-              "object_component_volumes": [float(v) for v in v2n(fd.GetArray("ObjectComponentVolumes"))]
-              if fd.GetArray("ObjectComponentVolumes") else None,
+              "object_component_volumes": [float(v) for v in v2n(fd.GetArray(fm.names.ObjectComponentVolumes))]
+              if fd.GetArray(fm.names.ObjectComponentVolumes) else None,
               "surface_smoothing": {"method": smooth.GetProperty("Method").GetData(), "iterations": int(smooth.Iterations),
                                     "boundary_nodes": int(smoothing["BoundaryNodes"]), "short_nodes": int(smoothing["ShortNodes"]),
                                     "pinched_nodes": int(smoothing["PinchedNodes"]),
@@ -211,14 +211,14 @@ def main():
         b.AmbientColor = b.DiffuseColor = [1.0, 0.2, 0.2]
         b.LineWidth = 2
         b.Position = [0, 0, 1]
-    elif int(field.get("Labels", 2)) > 2:
+    elif int(field.get(fm.names.Labels, 2)) > 2:
         # Several objects: each label's elements in its own colour, with a categorical legend.
-        objects = ps.Threshold(Input=ps.OutputPort(smooth, 1), Scalars=["CELLS", "Label"], LowerThreshold=1,
+        objects = ps.Threshold(Input=ps.OutputPort(smooth, 1), Scalars=["CELLS", fm.names.Label], LowerThreshold=1,
                                UpperThreshold=255)
         b = ps.Show(objects, view)
-        ps.ColorBy(b, ("CELLS", "Label"))
-        lut = ps.GetColorTransferFunction("Label")
-        region = fem.label_names(fem_mesh, v2n(fem_mesh.GetCellData().GetArray("Label")))
+        ps.ColorBy(b, ("CELLS", fm.names.Label))
+        lut = ps.GetColorTransferFunction(fm.names.Label)
+        region = fem.label_names(fem_mesh, v2n(fem_mesh.GetCellData().GetArray(fm.names.Label)))
         lut.InterpretValuesAsCategories = 1
         lut.Annotations = [str(v) for k in sorted(region) if k > 0 for v in (k, region[k])]
         lut.ApplyPreset("Brewer Qualitative Set1", True)

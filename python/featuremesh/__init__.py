@@ -17,11 +17,13 @@ from paraview import servermanager as sm
 import paraview.simple as ps
 from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 
+from . import names  # noqa: F401  (featuremesh.names.Label ...)
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DATA = os.environ.get("FEATUREMESH_DATA", os.path.join(ROOT, "Data"))
 SHARED = os.environ.get("FEATUREMESH_SHARED_DATA", os.path.join(os.path.dirname(ROOT), "shared", "data"))
 
-__all__ = ["ROOT", "DATA", "SHARED", "np", "v2n", "find_plugin", "load_plugin", "cases", "case_dir", "seeds", "fetch",
+__all__ = ["ROOT", "DATA", "SHARED", "np", "v2n", "names", "find_plugin", "load_plugin", "cases", "case_dir", "seeds", "fetch",
            "labels", "dice", "case_task", "Case", "open_image", "multilabel_cases", "MultiLabelCase", "label_names_from_csv"]
 
 

@@ -16,6 +16,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 
+from . import names as contract
+
 REGION_NAMES = {0: "background", 1: "object"}
 INTERFACE_TAG = 10
 INTERFACE_NAME = "interface"
@@ -29,7 +31,7 @@ def grid_arrays(grid):
     """(points (n, 3), cells (m, vpc), labels (m,)) of a triangle / tetrahedron vtkUnstructuredGrid."""
     points = v2n(grid.GetPoints().GetData()).astype(float)
     cells = v2n(grid.GetCells().GetConnectivityArray()).reshape(grid.GetNumberOfCells(), -1).astype(np.int64)
-    labels = v2n(grid.GetCellData().GetArray("Label")).astype(np.int64)
+    labels = v2n(grid.GetCellData().GetArray(contract.Label)).astype(np.int64)
     return points, cells, labels
 
 
@@ -62,7 +64,7 @@ def _outward(points, cells, owner, f, ids):
 def label_names(grid, labels):
     """{label: name} for the labels present: the grid's LabelNames field data where it names them,
     else REGION_NAMES, else label_L."""
-    given = grid.GetFieldData().GetAbstractArray("LabelNames") if grid.GetFieldData() else None
+    given = grid.GetFieldData().GetAbstractArray(contract.LabelNames) if grid.GetFieldData() else None
     binary = labels.max(initial=0) <= 1
     names = {}
     for L in (int(x) for x in np.unique(labels)):
