@@ -389,8 +389,8 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
   switch (values->GetDataType())
   {
     vtkTemplateMacro(perChannel = SeedBinsPerChannel(static_cast<const VTK_TT*>(values->GetVoidPointer(0)), channels,
-                       geometry, par.SampleSeedElements ? data.Cut.Owner.data() : nullptr, seeds, par.SeedRadius,
-                       par.Bins, par.Bandwidth));
+                       geometry, par.SampleSeedElements ? &mesh : nullptr, data.Cut.Owner.data(), seeds,
+                       par.SeedRadius, par.Bins, par.Bandwidth, &data.Bins));
   }
   if (data.Bins.Channels != channels || data.Bins.PerChannel != perChannel)
   {

@@ -75,24 +75,18 @@ std::string ValidateParameters(const BoykovJollyParameters& p)
   return std::string();
 }
 
-std::vector<double> SmoothedHistogram(
-  const std::vector<double>& s, const std::vector<double>& w, double low, double high, int bins, double bandwidth)
+double SilvermanBandwidth(const std::vector<double>& s, const std::vector<double>& w, double factor)
 {
-  std::vector<double> hist(bins, 0.0);
-  const double width = (high - low) / bins;
   double total = 0.0, mean = 0.0;
   for (size_t i = 0; i < s.size(); ++i)
   {
     const double wi = w.empty() ? 1.0 : w[i];
-    const int b = std::min(bins - 1, std::max(0, static_cast<int>((s[i] - low) / width)));
-    hist[b] += wi;
     total += wi;
     mean += wi * s[i];
   }
-  std::vector<double> density(bins, 1.0 / bins);
-  if (total <= 0.0)
+  if (!(total > 0.0))
   {
-    return density;
+    return 0.0;
   }
   mean /= total;
   double var = 0.0;
@@ -101,9 +95,30 @@ std::vector<double> SmoothedHistogram(
     var += (w.empty() ? 1.0 : w[i]) * (s[i] - mean) * (s[i] - mean);
   }
   const double sd = std::sqrt(var / total);
-  // Silverman's rule with the unweighted sample count: weights say how much a sample counts, not
-  // how many independent draws it is.
-  const double h = std::max(1.0, bandwidth * 1.06 * sd * std::pow(static_cast<double>(s.size()), -0.2) / width);
+  // The unweighted sample count: weights say how much a sample counts, not how many independent
+  // draws it is.
+  return factor * 1.06 * sd * std::pow(static_cast<double>(s.size()), -0.2);
+}
+
+std::vector<double> SmoothedHistogram(
+  const std::vector<double>& s, const std::vector<double>& w, double low, double high, int bins, double bandwidth)
+{
+  std::vector<double> hist(bins, 0.0);
+  const double width = (high - low) / bins;
+  double total = 0.0;
+  for (size_t i = 0; i < s.size(); ++i)
+  {
+    const double wi = w.empty() ? 1.0 : w[i];
+    const int b = std::min(bins - 1, std::max(0, static_cast<int>((s[i] - low) / width)));
+    hist[b] += wi;
+    total += wi;
+  }
+  std::vector<double> density(bins, 1.0 / bins);
+  if (total <= 0.0)
+  {
+    return density;
+  }
+  const double h = std::max(1.0, SilvermanBandwidth(s, w, bandwidth) / width);
   const int radius = static_cast<int>(std::ceil(3.0 * h));
   double sum = 0.0;
   for (int b = 0; b < bins; ++b)
@@ -130,25 +145,9 @@ int AutomaticBins(const std::vector<WeightedSamples>& samples, double low, doubl
   double narrowest = 1.0; // bandwidth in bins of `width`
   for (const WeightedSamples& set : samples)
   {
-    const std::vector<double>& s = *set.Values;
-    const std::vector<double>* w = set.Weights && !set.Weights->empty() ? set.Weights : nullptr;
-    double total = 0.0, mean = 0.0;
-    for (std::size_t i = 0; i < s.size(); ++i)
-    {
-      total += w ? (*w)[i] : 1.0;
-      mean += (w ? (*w)[i] : 1.0) * s[i];
-    }
-    if (s.size() < 2 || !(total > 0.0) || !(width > 0.0))
-    {
-      continue;
-    }
-    mean /= total;
-    double var = 0.0;
-    for (std::size_t i = 0; i < s.size(); ++i)
-    {
-      var += (w ? (*w)[i] : 1.0) * (s[i] - mean) * (s[i] - mean);
-    }
-    const double h = bandwidth * 1.06 * std::sqrt(var / total) * std::pow(static_cast<double>(s.size()), -0.2) / width;
+    const double h = set.Values->size() < 2 || !(width > 0.0)
+      ? 0.0
+      : SilvermanBandwidth(*set.Values, set.Weights ? *set.Weights : std::vector<double>(), bandwidth) / width;
     // A density of one value is a spike at any bin width.
     if (h > 0.0)
     {

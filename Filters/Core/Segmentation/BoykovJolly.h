@@ -125,6 +125,10 @@ struct CutResult
 
 std::string ValidateParameters(const BoykovJollyParameters& p);
 
+// Silverman's kernel bandwidth of weighted samples (weights empty: 1 each) times `factor`, in their
+// units: factor x 1.06 x the weighted standard deviation x n^-1/5, n the unweighted count; 0 without weight.
+double SilvermanBandwidth(const std::vector<double>& samples, const std::vector<double>& weights, double factor);
+
 // Probability density of each histogram bin from weighted samples (Silverman bandwidth, at least
 // one bin), on [low, high]; mixed with 1 % uniform.
 std::vector<double> SmoothedHistogram(const std::vector<double>& samples, const std::vector<double>& weights,

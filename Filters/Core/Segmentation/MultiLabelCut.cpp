@@ -30,6 +30,15 @@ double ChannelPercentile(const T* values, int channels, int c, std::int64_t voxe
   return v[k];
 }
 
+// Channel c's histogram range: its 0.5 and 99.5 percentiles, one unit wide when they meet.
+template <typename T>
+std::array<double, 2> ChannelRange(const T* values, int channels, int c, std::int64_t voxels)
+{
+  const double low = ChannelPercentile(values, channels, c, voxels, 0.5);
+  const double high = ChannelPercentile(values, channels, c, voxels, 99.5);
+  return { { low, high > low ? high : low + 1.0 } };
+}
+
 // A Gaussian blur of `grid` (PerChannel^channels bins) along `axis`, sigma `h` bins, truncated at 3h.
 void BlurAxis(std::vector<double>& grid, int perChannel, int channels, int axis, double h)
 {
@@ -352,11 +361,10 @@ bool BinChannels(const T* values, int channels, std::int64_t voxels, int bins, C
   out.PerChannel = BinsPerChannel(channels, bins);
   for (int c = 0; c < channels; ++c)
   {
-    const double low = ChannelPercentile(values, channels, c, voxels, 0.5);
-    double high = ChannelPercentile(values, channels, c, voxels, 99.5);
-    high = high > low ? high : low + 1.0;
-    out.Low.push_back(low);
-    out.Width.push_back((high - low) / out.PerChannel);
+    const std::array<double, 2> range = ChannelRange(values, channels, c, voxels);
+    out.Low.push_back(range[0]);
+    out.High.push_back(range[1]);
+    out.Width.push_back((range[1] - range[0]) / out.PerChannel);
   }
   out.Bin.resize(voxels);
   const int per = out.PerChannel;
@@ -405,34 +413,28 @@ void NodeChannelMeans(const std::int32_t* owner, const T* values, int channels, 
 }
 
 template <typename T>
-int SeedBinsPerChannel(const T* values, int channels, const ImageGeometry& g, const std::int32_t* owner,
-  const LabelledSeeds& seeds, double radius, int bins, double bandwidth)
+int SeedBinsPerChannel(const T* values, int channels, const ImageGeometry& g, const SimplexMesh* mesh,
+  const std::int32_t* owner, const LabelledSeeds& seeds, double radius, int bins, double bandwidth,
+  const ChannelBins* binned)
 {
   if (bins > 0 || channels != 1 || seeds.Voxel.empty())
   {
     return BinsPerChannel(channels, bins);
   }
-  const std::int64_t voxels = g.Size();
   std::vector<std::vector<double>> samples(LabelCount(seeds));
-  if (owner)
+  if (mesh && owner)
   {
-    std::vector<std::int16_t> label;
+    std::map<std::int32_t, std::uint8_t> element; // each seed element and its label
     for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
     {
-      const std::int32_t p = owner[seeds.Voxel[s]];
-      if (p >= 0)
+      if (owner[seeds.Voxel[s]] >= 0)
       {
-        label.resize(std::max<std::size_t>(label.size(), static_cast<std::size_t>(p) + 1), -1);
-        label[p] = seeds.Label[s];
+        element[owner[seeds.Voxel[s]]] = seeds.Label[s];
       }
     }
-    for (std::int64_t v = 0; v < voxels; ++v)
+    for (const auto& e : element)
     {
-      const std::int32_t p = owner[v];
-      if (p >= 0 && static_cast<std::size_t>(p) < label.size() && label[p] >= 0)
-      {
-        samples[label[p]].push_back(static_cast<double>(values[v]));
-      }
+      ForEachElementVoxel(*mesh, owner, e.first, [&](std::int64_t v) { samples[e.second].push_back(static_cast<double>(values[v])); });
     }
   }
   else
@@ -442,20 +444,21 @@ int SeedBinsPerChannel(const T* values, int channels, const ImageGeometry& g, co
       ForEachVoxelWithin(g, seeds.Voxel[s], radius, [&](std::int64_t v) { samples[seeds.Label[s]].push_back(static_cast<double>(values[v])); });
     }
   }
-  const double low = ChannelPercentile(values, 1, 0, voxels, 0.5);
-  double high = ChannelPercentile(values, 1, 0, voxels, 99.5);
-  high = high > low ? high : low + 1.0;
+  // The range the image was binned with, else the same percentiles afresh.
+  const std::array<double, 2> range = binned && binned->Channels == 1 && binned->High.size() == 1
+    ? std::array<double, 2>{ { binned->Low[0], binned->High[0] } }
+    : ChannelRange(values, 1, 0, g.Size());
   std::vector<WeightedSamples> sets;
   for (const std::vector<double>& s : samples)
   {
     sets.push_back({ &s, nullptr });
   }
-  return AutomaticBins(sets, low, high, bandwidth);
+  return AutomaticBins(sets, range[0], range[1], bandwidth);
 }
 
 #define FEATUREMESH_CHANNELS(T)                                                                                          \
-  template int SeedBinsPerChannel<T>(const T*, int, const ImageGeometry&, const std::int32_t*, const LabelledSeeds&,     \
-    double, int, double);                                                                                                \
+  template int SeedBinsPerChannel<T>(const T*, int, const ImageGeometry&, const SimplexMesh*, const std::int32_t*,      \
+    const LabelledSeeds&, double, int, double, const ChannelBins*);                                                     \
   template bool BinChannels<T>(const T*, int, std::int64_t, int, ChannelBins&, std::string&, const ParallelFor&);       \
   template void NodeChannelMeans<T>(const std::int32_t*, const T*, int, std::int64_t, std::int64_t, std::vector<double>&, \
     std::vector<double>&);

@@ -52,7 +52,7 @@ struct MultiLabelParameters
 struct ChannelBins
 {
   int Channels = 0, PerChannel = 0;
-  std::vector<double> Low, Width;
+  std::vector<double> Low, High, Width;
   std::vector<std::uint16_t> Bin;
   int Count() const;
 };
@@ -63,11 +63,13 @@ int BinsPerChannel(int channels, int bins);
 
 // Bins per channel for labelled seeds: BinsPerChannel(channels, bins), except with automatic bins
 // (0) on one channel: AutomaticBins (BoykovJolly.h) of each label's samples on the channel's
-// 0.5-99.5 percentile range. The samples are the voxels of the seeds' elements (`owner`, one per
-// voxel) or, without an owner map, those within `radius` of each seed, as the cuts sample them.
+// 0.5-99.5 percentile range (`binned`'s, when it binned this image). The samples are the voxels of
+// the seeds' elements (`mesh` and its `owner` map) or, without them, those within `radius` of each
+// seed, as the cuts sample them.
 template <typename T>
-int SeedBinsPerChannel(const T* values, int channels, const ImageGeometry& geometry, const std::int32_t* owner,
-  const LabelledSeeds& seeds, double radius, int bins, double bandwidth);
+int SeedBinsPerChannel(const T* values, int channels, const ImageGeometry& geometry, const SimplexMesh* mesh,
+  const std::int32_t* owner, const LabelledSeeds& seeds, double radius, int bins, double bandwidth,
+  const ChannelBins* binned = nullptr);
 
 // `values` (voxels x channels, interleaved, any arithmetic type) binned into `out`; false with a
 // sentence for a value that is not finite or beyond +-1e150.

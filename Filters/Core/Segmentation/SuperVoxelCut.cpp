@@ -62,35 +62,11 @@ std::vector<std::uint8_t> BorderVoxels(const ImageGeometry& g)
 
 namespace
 {
-// Appends the values of the voxels `owner` gives to element e, in raster order: those of its box
-// widened by a voxel (the map may come from the points before a world round trip, within rounding).
+// Appends the values of the voxels `owner` gives to element e, in raster order.
 void ElementVoxelValues(const SimplexMesh& mesh, const VoxelOwnerMap& owner, const NodeVoxelValues& voxels,
   std::int64_t e, std::vector<double>& out)
 {
-  const ImageGeometry& g = mesh.Geometry();
-  std::array<int, 3> lo = g.Dims, hi{ { -1, -1, -1 } };
-  for (int k = 0; k < mesh.VerticesPerCell(); ++k)
-  {
-    const auto& q = mesh.Points()[mesh.Cell(e)[k]];
-    for (int a = 0; a < 3; ++a)
-    {
-      lo[a] = std::min(lo[a], std::max(0, static_cast<int>(std::floor(q[a])) - 1));
-      hi[a] = std::max(hi[a], std::min(g.Dims[a] - 1, static_cast<int>(std::ceil(q[a])) + 1));
-    }
-  }
-  for (int z = lo[2]; z <= hi[2]; ++z)
-  {
-    for (int y = lo[1]; y <= hi[1]; ++y)
-    {
-      for (std::int64_t v = g.Index(lo[0], y, z), end = v + (hi[0] - lo[0]) + 1; v < end; ++v)
-      {
-        if (owner[v] == e)
-        {
-          out.push_back(voxels.Value(v));
-        }
-      }
-    }
-  }
+  ForEachElementVoxel(mesh, owner.data(), e, [&](std::int64_t v) { out.push_back(voxels.Value(v)); });
 }
 } // namespace
 

@@ -9,6 +9,8 @@
 #include "SeedConnectivity.h"
 #include "SimplexMesh.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -153,6 +155,38 @@ void ForEachVoxelWithin(const ImageGeometry& g, std::int64_t v, double radius, F
           f(g.Index(i + di, j + dj, k + dk));
         }
       }
+}
+
+// f(voxel) for each voxel `owner` (one per voxel) gives to element e, in raster order: a scan of the
+// element's box widened by a voxel (the map may come from the points before a world round trip,
+// within rounding).
+template <typename F>
+void ForEachElementVoxel(const SimplexMesh& mesh, const std::int32_t* owner, std::int64_t e, F&& f)
+{
+  const ImageGeometry& g = mesh.Geometry();
+  std::array<int, 3> lo = g.Dims, hi{ { -1, -1, -1 } };
+  for (int k = 0; k < mesh.VerticesPerCell(); ++k)
+  {
+    const auto& q = mesh.Points()[mesh.Cell(e)[k]];
+    for (int a = 0; a < 3; ++a)
+    {
+      lo[a] = std::min(lo[a], std::max(0, static_cast<int>(std::floor(q[a])) - 1));
+      hi[a] = std::max(hi[a], std::min(g.Dims[a] - 1, static_cast<int>(std::ceil(q[a])) + 1));
+    }
+  }
+  for (int z = lo[2]; z <= hi[2]; ++z)
+  {
+    for (int y = lo[1]; y <= hi[1]; ++y)
+    {
+      for (std::int64_t v = g.Index(lo[0], y, z), end = v + (hi[0] - lo[0]) + 1; v < end; ++v)
+      {
+        if (owner[v] == e)
+        {
+          f(v);
+        }
+      }
+    }
+  }
 }
 
 // 1 for the voxels on the image's border (its box faces), else 0.
