@@ -27,6 +27,7 @@
 vtkStandardNewMacro(vtkDelaunayImageMesh);
 
 vtkDelaunayImageMesh::vtkDelaunayImageMesh()
+  : featuremesh::FilterBase(this, "Delaunay Image Mesh")
 {
   this->SetNumberOfInputPorts(2);
   this->SetInputArrayToProcess(
@@ -61,91 +62,50 @@ int vtkDelaunayImageMesh::RequestUpdateExtent(
 int vtkDelaunayImageMesh::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return featuremesh::RunFilter(this, "Delaunay Image Mesh", outputVector, this->FailedAt, this->FailedAtTime, [&]() -> int {
+  return this->Run(outputVector, [&]() -> int {
     using namespace featuremesh;
-    using Clock = std::chrono::steady_clock;
-    const auto start = Clock::now();
     vtkPointSet* nodes = vtkPointSet::GetData(inputVector[0], 0);
     vtkSmartPointer<vtkImageData> image =
       VoxelValuedImage(vtkImageData::GetData(inputVector[1], 0), this->GetInputArrayInformation(0));
     vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
     DropVoxelOwners(output); // the last run's map, which the executive's reset leaves on the object
-    std::string error, warning;
-    ImageGeometry geometry;
-    if (IsEmptyPiece(outputVector, nodes) || IsEmptyPiece(outputVector, image))
+    if (const int done = this->Start(outputVector, { nodes, image }); done >= 0)
     {
-      return 1;
+      return done;
     }
     if (!nodes || !image)
     {
-      vtkErrorMacro("Delaunay Image Mesh: both the Nodes (point set) and the Image inputs are required.");
-      return 0;
+      return this->Fail("both the Nodes (point set) and the Image inputs are required.");
     }
-    if (!ImageGeometryOf(image, geometry, error))
+    ImageGeometry geometry;
+    // The image is read in its own type (checked as ToDouble would, without the copy).
+    vtkDataArray* values = this->Frame(image, geometry) ? this->ChosenImageArray(image, this->GetInputArrayInformation(0)) : nullptr;
+    std::string error;
+    if (!values || !CheckDouble(values, error))
     {
-      vtkErrorMacro("Delaunay Image Mesh: " << error);
-      return 0;
+      return values ? this->Fail(error) : 0;
     }
     const bool is2D = geometry.Is2D();
     const vtkIdType nIn = nodes->GetNumberOfPoints();
-    // The image is read in its own type (checked as ToDouble would, without the copy).
-    vtkDataArray* values = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
-    const bool valuesOk = values && CheckDouble(values, error);
-    if (!warning.empty())
-    {
-      vtkWarningMacro("Delaunay Image Mesh: " << warning);
-    }
-    if (!valuesOk)
-    {
-      vtkErrorMacro("Delaunay Image Mesh: " << error);
-      return 0;
-    }
-
     std::vector<std::array<double, 3>> index = PointsOf(nodes);
     error = ImageMeshNodes(geometry, index);
-    if (error.empty())
+    if (!error.empty() || !(error = ValidateParameters(*this, is2D)).empty())
     {
-      error = ValidateParameters(*this, is2D);
-    }
-    if (!error.empty())
-    {
-      vtkErrorMacro("Delaunay Image Mesh: " << error);
-      return 0;
+      return this->Fail(error);
     }
     const vtkIdType firstSteiner = static_cast<vtkIdType>(index.size());
     this->UpdateProgress(0.1);
 
-    // Delaunay in frame coordinates: the right metric for anisotropic voxels, and the same mesh
-    // whatever the image's origin, direction or mirror.
-    auto t0 = Clock::now();
-    std::vector<std::array<double, 3>> frame(index.size());
-    std::transform(index.begin(), index.end(), frame.begin(), [&](const std::array<double, 3>& p) { return geometry.IndexToFrame(p); });
-    const DelaunayOptions o = *this;
-    // TetGen has no progress or abort of its own: it runs on its own thread, owning its input.
+    double delaunaySeconds = this->Seconds();
     DelaunayResult delaunay;
-    if (is2D)
+    if (!this->Triangulate(geometry, index, delaunay))
     {
-      delaunay = Triangulate2D(frame);
+      return delaunay.Error.empty() ? 1 : this->Fail(delaunay.Error); // aborted, or TetGen's error
     }
-    else if (!RunWithHeartbeat<DelaunayResult>([frame, o]() { return Tetrahedralize(frame, o); },
-               AlgorithmProgress(this, 0.1, 0.5), delaunay))
-    {
-      return 1;
-    }
-    if (!delaunay.Error.empty())
-    {
-      vtkErrorMacro("Delaunay Image Mesh: " << delaunay.Error);
-      return 0;
-    }
-    const double delaunaySeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    delaunaySeconds = this->Seconds() - delaunaySeconds;
     this->UpdateProgress(0.5);
-    // Points the mesher added (TetGen refinement).
-    for (size_t i = index.size(); i < delaunay.Points.size(); ++i)
-    {
-      index.push_back(geometry.FrameToIndex(delaunay.Points[i]));
-    }
 
-    t0 = Clock::now();
+    double statisticsSeconds = this->Seconds();
     const ParallelFor parallel = SMPParallelFor();
     const SimplexMesh mesh(geometry, std::move(index), std::move(delaunay.Cells), delaunay.VerticesPerCell);
     const vtkSmartPointer<vtkIntArray> owner = NewVoxelOwnerArray(outputVector, geometry.Size());
@@ -157,23 +117,51 @@ int vtkDelaunayImageMesh::RequestData(
     }
     std::vector<double> minAngle, radiusRatio;
     ElementQuality(mesh, minAngle, radiusRatio, parallel);
-    const double statisticsSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    statisticsSeconds = this->Seconds() - statisticsSeconds;
     this->UpdateProgress(0.9);
     WriteImageMesh(mesh, stats, minAngle, radiusRatio, output);
     AttachVoxelOwners(output, owner);
-
     // Node arrays pass through; added nodes get NodeType Added and Fixed 1 (corners) or 0 (refinement).
     const vtkIdType nPts = mesh.NumberOfPoints();
     PassNodeArrays(nodes->GetPointData(), nIn, output->GetPointData(), nPts, firstSteiner);
-
-    AddFieldValue(output, names::AddedNodes, static_cast<double>(nPts - nIn));
-    AddFieldValue(output, names::DelaunayBackend, is2D || this->GetBackend() == CGAL ? 1.0 : 0.0);
-    AddFieldValue(output, names::DelaunaySeconds, delaunaySeconds);
-    AddFieldValue(output, names::StatisticsSeconds, statisticsSeconds);
-    AddFieldValue(output, names::TotalSeconds, std::chrono::duration<double>(Clock::now() - start).count());
+    AddFieldValues(output, { { names::AddedNodes, static_cast<double>(nPts - nIn) },
+                             { names::DelaunayBackend, is2D || this->GetBackend() == CGAL ? 1.0 : 0.0 },
+                             { names::DelaunaySeconds, delaunaySeconds }, { names::StatisticsSeconds, statisticsSeconds },
+                             { names::TotalSeconds, this->Seconds() } });
     this->UpdateProgress(1.0);
     return 1;
   });
+}
+
+bool vtkDelaunayImageMesh::Triangulate(
+  const featuremesh::ImageGeometry& geometry, std::vector<std::array<double, 3>>& index, featuremesh::DelaunayResult& delaunay)
+{
+  using namespace featuremesh;
+  // Delaunay in frame coordinates: the right metric for anisotropic voxels, and the same mesh
+  // whatever the image's origin, direction or mirror.
+  std::vector<std::array<double, 3>> frame(index.size());
+  std::transform(index.begin(), index.end(), frame.begin(), [&](const std::array<double, 3>& p) { return geometry.IndexToFrame(p); });
+  const DelaunayOptions o = *this;
+  // TetGen has no progress or abort of its own: it runs on its own thread, owning its input.
+  if (geometry.Is2D())
+  {
+    delaunay = Triangulate2D(frame);
+  }
+  else if (!RunWithHeartbeat<DelaunayResult>([frame, o]() { return Tetrahedralize(frame, o); },
+             AlgorithmProgress(this, 0.1, 0.5), delaunay))
+  {
+    return false;
+  }
+  if (!delaunay.Error.empty())
+  {
+    return false;
+  }
+  // Points the mesher added (TetGen refinement).
+  for (size_t i = index.size(); i < delaunay.Points.size(); ++i)
+  {
+    index.push_back(geometry.FrameToIndex(delaunay.Points[i]));
+  }
+  return true;
 }
 
 std::string vtkDelaunayImageMesh::ValidateProperties()

@@ -18,13 +18,18 @@
 
 #include "DelaunayMesh.h" // the parameters, declared once
 #include "FeatureMeshFiltersModule.h"
+#include "vtkFeatureMeshFilter.h" // the shared run and start-up
 #include "vtkUnstructuredGridAlgorithm.h"
+
+#include <array>
+#include <vector>
 
 // The filter is its Core parameters (TTK's shape): each property's value and default live in
 // featuremesh::DelaunayOptions, which the setters write.
 class FEATUREMESHFILTERS_EXPORT vtkDelaunayImageMesh
   : public vtkUnstructuredGridAlgorithm
   , protected featuremesh::DelaunayOptions
+  , protected featuremesh::FilterBase
 {
 public:
   static vtkDelaunayImageMesh* New();
@@ -32,7 +37,7 @@ public:
   void PrintSelf(ostream& os, vtkIndent indent) override;
   /// Empty when the properties are usable, else the sentence Apply would fail with (3D bounds:
   /// a 2D image takes any refinement bound).
-  std::string ValidateProperties();
+  std::string ValidateProperties() override;
 
   enum Backends
   {
@@ -62,11 +67,12 @@ protected:
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  // The Delaunay mesh of the nodes (image index coordinates), the mesher's added nodes appended to
+  // `index`; false when aborted or with delaunay.Error set.
+  bool Triangulate(const featuremesh::ImageGeometry& geometry, std::vector<std::array<double, 3>>& index,
+    featuremesh::DelaunayResult& delaunay);
 
 private:
-  // The pipeline state of the last failed run (0: none), so that it is not repeated.
-  vtkMTimeType FailedAt = 0;
-  double FailedAtTime = 0.0;
   vtkDelaunayImageMesh(const vtkDelaunayImageMesh&) = delete;
   void operator=(const vtkDelaunayImageMesh&) = delete;
 };

@@ -215,19 +215,20 @@ vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::s
   return array;
 }
 
-bool ChosenValues(vtkImageData* image, vtkInformation* arrayInfo, std::vector<double>& values, std::string& error,
-  std::string& warning)
-{
-  vtkDataArray* array = ChosenArray(image, arrayInfo, error, warning);
-  return array && ToDouble(array, values, error);
-}
-
 void AddFieldValue(vtkDataObject* object, const char* name, double value)
 {
   vtkNew<vtkDoubleArray> a;
   a->SetName(name);
   a->InsertNextValue(value);
   object->GetFieldData()->AddArray(a);
+}
+
+void AddFieldValues(vtkDataObject* object, std::initializer_list<std::pair<const char*, double>> values)
+{
+  for (const auto& v : values)
+  {
+    AddFieldValue(object, v.first, v.second);
+  }
 }
 
 void AddObjectComponents(vtkDataObject* object, const std::vector<double>& componentVoxels, double voxelVolume,

@@ -8,7 +8,9 @@
 #include "vtkSmartPointer.h"
 
 #include <cstdint>
+#include <initializer_list>
 #include <string>
+#include <utility>
 #include <vector>
 
 class vtkDataObject;
@@ -45,13 +47,10 @@ vtkSmartPointer<vtkImageData> VoxelValuedImage(vtkImageData* image, vtkInformati
 // a warning sentence; null with an error sentence when there are none.
 vtkDataArray* ChosenArray(vtkImageData* image, vtkInformation* arrayInfo, std::string& error, std::string& warning);
 
-// The values of the chosen array (ChosenArray) as doubles; false with `error` set when unusable.
-// `warning` is set when the chosen name fell back to the active scalars.
-bool ChosenValues(vtkImageData* image, vtkInformation* arrayInfo, std::vector<double>& values, std::string& error,
-  std::string& warning);
-
 // Adds a one-value double array `name` to the object's field data (summaries, timings).
 void AddFieldValue(vtkDataObject* object, const char* name, double value);
+// AddFieldValue of each (name, value), in order.
+void AddFieldValues(vtkDataObject* object, std::initializer_list<std::pair<const char*, double>> values);
 
 // Field data Labels (the count) and LabelNames (uint8, one tuple of the label values 0..k whose
 // component names are the labels' names, from `names` split at ';', empty where it gives none).

@@ -22,6 +22,19 @@
 #include <string>
 namespace featuremesh
 {
+std::string ImageMeshProblem(vtkUnstructuredGrid* grid)
+{
+  if (!grid || grid->GetNumberOfCells() == 0)
+  {
+    return "the mesh is empty.";
+  }
+  if (!grid->GetCellData()->GetArray(names::MeanIntensity) || !grid->GetCellData()->GetArray(names::PixelCount))
+  {
+    return "the mesh has no MeanIntensity and PixelCount cell arrays; make it with Delaunay Image Mesh.";
+  }
+  return std::string();
+}
+
 bool ToSimplexMesh(vtkUnstructuredGrid* grid, const ImageGeometry& geometry, SimplexMesh& mesh, std::string& error)
 {
   const vtkIdType nCells = grid ? grid->GetNumberOfCells() : 0;

@@ -27,6 +27,10 @@ namespace featuremesh
 // types, or a cell type that does not match the image's dimension.
 bool ToSimplexMesh(vtkUnstructuredGrid* grid, const ImageGeometry& geometry, SimplexMesh& mesh, std::string& error);
 
+// Why `grid` is not an image mesh (stage 2's or 3's output: cells with MeanIntensity and
+// PixelCount), or "" when it is one.
+std::string ImageMeshProblem(vtkUnstructuredGrid* grid);
+
 // The image-mesh output of stages 2 and 3: world points, cells (positively oriented in world
 // coordinates), the statistics and quality cell arrays, the image frame and summary field data.
 void WriteImageMesh(const SimplexMesh& mesh, const ElementStatistics& statistics, const std::vector<double>& minAngle,

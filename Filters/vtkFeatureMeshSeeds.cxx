@@ -14,6 +14,7 @@
 #include "vtkType.h"
 
 #include <cstring>
+#include <algorithm>
 #include <string>
 namespace featuremesh
 {
@@ -132,6 +133,19 @@ bool LabelledSeedVoxels(vtkDataObject* seeds, const char* labelArray, const Imag
   for (double l : labels)
   {
     out.Label.push_back(static_cast<std::uint8_t>(l));
+  }
+  return true;
+}
+
+bool BinarySeedVoxels(const LabelledSeeds& seeds, std::vector<std::int64_t>& object, std::vector<std::int64_t>& background)
+{
+  if (std::any_of(seeds.Label.begin(), seeds.Label.end(), [](std::uint8_t l) { return l > 1; }))
+  {
+    return false;
+  }
+  for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
+  {
+    (seeds.Label[s] ? object : background).push_back(seeds.Voxel[s]);
   }
   return true;
 }

@@ -34,6 +34,10 @@ bool ObjectAndBackgroundVoxels(vtkDataObject* object, vtkDataObject* background,
 // (0 background, 1..k objects, checked by ValidateSeedLabels). False with a sentence.
 bool LabelledSeedVoxels(vtkDataObject* seeds, const char* labelArray, const ImageGeometry& geometry,
   LabelledSeeds& out, std::string& error);
+
+// True when `seeds` hold the labels 0 and 1 only, the binary cut's seeds: `object` and `background`
+// then get their voxels.
+bool BinarySeedVoxels(const LabelledSeeds& seeds, std::vector<std::int64_t>& object, std::vector<std::int64_t>& background);
 } // namespace featuremesh
 
 #endif

@@ -18,6 +18,7 @@
 #define vtkFeatureNodes_h
 
 #include "FeatureMeshFiltersModule.h"
+#include "vtkFeatureMeshFilter.h" // the shared run and start-up
 #include "FeatureNodes.h" // the parameters, declared once
 #include "vtkPolyDataAlgorithm.h"
 
@@ -28,13 +29,14 @@ class vtkImageData;
 class FEATUREMESHFILTERS_EXPORT vtkFeatureNodes
   : public vtkPolyDataAlgorithm
   , protected featuremesh::FeatureNodeParameters
+  , protected featuremesh::FilterBase
 {
 public:
   static vtkFeatureNodes* New();
   vtkTypeMacro(vtkFeatureNodes, vtkPolyDataAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
   /// Empty when the properties are usable, else the sentence Apply would fail with.
-  std::string ValidateProperties();
+  std::string ValidateProperties() override;
 
   /// Standard deviation (voxels) of the Gaussian applied before Canny. Default 0.7.
   vtkSetMacro(GaussianSigma, double);
@@ -110,12 +112,8 @@ protected:
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
-  int Execute(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
 
 private:
-  // The pipeline state of the last failed run (0: none), so that it is not repeated.
-  vtkMTimeType FailedAt = 0;
-  double FailedAtTime = 0.0;
   vtkFeatureNodes(const vtkFeatureNodes&) = delete;
   void operator=(const vtkFeatureNodes&) = delete;
 };

@@ -16,9 +16,44 @@
 #include <algorithm>
 #include <chrono>
 
+namespace
+{
+// The nodes' Fixed flags (stage 1's array, passed on by stage 2); without the array every node is
+// free (the box corners still stay).
+std::vector<std::uint8_t> FixedNodes(vtkUnstructuredGrid* input)
+{
+  const vtkIdType n = input->GetNumberOfPoints();
+  std::vector<std::uint8_t> fixed(n, 0);
+  if (vtkDataArray* array = input->GetPointData()->GetArray(featuremesh::names::Fixed))
+  {
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      fixed[i] = array->GetComponent(i, 0) != 0 ? 1 : 0;
+    }
+  }
+  return fixed;
+}
+
+// The field data of a smoothing run: the smallest angle before, the counts of each step and the seconds.
+void AddSmoothingFields(vtkDataObject* output, const featuremesh::MeshSmoothingResult& result, bool is2D, double before,
+  double smoothingSeconds, double statisticsSeconds, double totalSeconds)
+{
+  namespace names = featuremesh::names;
+  featuremesh::AddFieldValues(output,
+    { { is2D ? names::MinAngleBefore : names::MinDihedralAngleBefore, before }, { names::IterationsRun, result.IterationsRun },
+      { names::SmoothingMoves, double(result.Moves) }, { names::EdgeFlips, double(result.Flips) },
+      { names::SliverMoves, double(result.Perturbed) }, { names::AddedNodes, double(result.AddedNodes) },
+      { names::SnappedNodes, double(result.SnappedNodes) }, { names::SmoothingSeconds, smoothingSeconds },
+      { names::SweepSeconds, result.SweepSeconds }, { names::RefinementSeconds, result.RefinementSeconds },
+      { names::SliverSeconds, result.SliverSeconds }, { names::StatisticsSeconds, statisticsSeconds },
+      { names::TotalSeconds, totalSeconds } });
+}
+} // namespace
+
 vtkStandardNewMacro(vtkImageMeshSmoothing);
 
 vtkImageMeshSmoothing::vtkImageMeshSmoothing()
+  : featuremesh::FilterBase(this, "Image Mesh Smoothing")
 {
   this->SetNumberOfInputPorts(2);
   this->SetInputArrayToProcess(
@@ -55,10 +90,8 @@ int vtkImageMeshSmoothing::RequestUpdateExtent(
 int vtkImageMeshSmoothing::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return featuremesh::RunFilter(this, "Image Mesh Smoothing", outputVector, this->FailedAt, this->FailedAtTime, [&]() -> int {
+  return this->Run(outputVector, [&]() -> int {
     using namespace featuremesh;
-    using Clock = std::chrono::steady_clock;
-    const auto start = Clock::now();
     vtkUnstructuredGrid* input = vtkUnstructuredGrid::GetData(inputVector[0], 0);
     vtkSmartPointer<vtkImageData> image =
       VoxelValuedImage(vtkImageData::GetData(inputVector[1], 0), this->GetInputArrayInformation(0));
@@ -68,40 +101,22 @@ int vtkImageMeshSmoothing::RequestData(
     {
       ReleaseVoxelOwners(input); // this stage rasterises its own moved mesh
     }
-    std::string error, warning;
-    auto fail = [&](const std::string& why) {
-      vtkErrorMacro("Image Mesh Smoothing: " << why);
-      return 0;
-    };
-
-    const MeshSmoothingParameters& par = *this;
-    error = this->ValidateProperties();
-    if (!error.empty())
+    if (const int done = this->Start(outputVector, { input, image }); done >= 0)
     {
-      return fail(error);
+      return done;
     }
-    if (IsEmptyPiece(outputVector, input) || IsEmptyPiece(outputVector, image))
+    std::string error = ImageMeshProblem(input);
+    if (error.empty() && !image)
     {
-      return 1;
-    }
-    if (!input || input->GetNumberOfCells() == 0)
-    {
-      return fail("the mesh is empty.");
-    }
-    if (!image)
-    {
-      return fail("the Image input is required: the moved elements' statistics are recomputed from it.");
-    }
-    if (!input->GetCellData()->GetArray(names::PixelCount) || !input->GetCellData()->GetArray(names::MeanIntensity))
-    {
-      return fail("the mesh has no PixelCount and MeanIntensity cell arrays; make it with Delaunay Image Mesh.");
+      error = "the Image input is required: the moved elements' statistics are recomputed from it.";
     }
     // The image's frame; a mesh that records its own must match it.
     ImageGeometry geometry;
-    if (!ImageGeometryOf(image, geometry, error) || !MeshMatchesImage(input, geometry, error))
+    if (!error.empty() || !ImageGeometryOf(image, geometry, error) || !MeshMatchesImage(input, geometry, error))
     {
-      return fail(error);
+      return this->Fail(error);
     }
+    const MeshSmoothingParameters& par = *this;
     if (par.Iterations == 0)
     {
       output->ShallowCopy(input);
@@ -110,31 +125,17 @@ int vtkImageMeshSmoothing::RequestData(
     SimplexMesh mesh;
     if (!ToSimplexMesh(input, geometry, mesh, error))
     {
-      return fail(error);
+      return this->Fail(error);
     }
     this->UpdateProgress(0.02);
     // The exact statistics read the array in its own type; the density reads floats (the array
     // itself when it is float).
-    vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
-    if (!warning.empty())
-    {
-      vtkWarningMacro("Image Mesh Smoothing: " << warning);
-    }
+    vtkDataArray* array = this->ChosenImageArray(image, this->GetInputArrayInformation(0));
     std::vector<float> floatStorage;
     const float* floats = array && CheckDouble(array, error) ? FloatValues(array, floatStorage, error) : nullptr;
     if (!floats)
     {
-      return fail(error);
-    }
-    // Nodes without a Fixed array are all free (box corners still stay).
-    const vtkIdType nPts = input->GetNumberOfPoints();
-    std::vector<std::uint8_t> fixed(nPts, 0);
-    if (vtkDataArray* fixedArray = input->GetPointData()->GetArray(names::Fixed))
-    {
-      for (vtkIdType i = 0; i < nPts; ++i)
-      {
-        fixed[i] = fixedArray->GetComponent(i, 0) != 0 ? 1 : 0;
-      }
+      return array ? this->Fail(error) : 0;
     }
     const ParallelFor parallel = SMPParallelFor();
     std::vector<double> minAngle, radiusRatio;
@@ -142,20 +143,17 @@ int vtkImageMeshSmoothing::RequestData(
     const double before = minAngle.empty() ? 0.0 : *std::min_element(minAngle.begin(), minAngle.end());
     this->UpdateProgress(0.05);
 
-    auto t0 = Clock::now();
-    MeshSmoothingResult result = SmoothImageMesh(mesh, fixed, floats, par, parallel, AlgorithmProgress(this, 0.05, 0.6));
-    if (result.Aborted)
+    double smoothingSeconds = this->Seconds();
+    MeshSmoothingResult result =
+      SmoothImageMesh(mesh, FixedNodes(input), floats, par, parallel, AlgorithmProgress(this, 0.05, 0.6));
+    if (result.Aborted || !result.Error.empty())
     {
-      return 1;
+      return result.Aborted ? 1 : this->Fail(result.Error);
     }
-    if (!result.Error.empty())
-    {
-      return fail(result.Error);
-    }
-    const double smoothingSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    smoothingSeconds = this->Seconds() - smoothingSeconds;
     std::vector<float>().swap(floatStorage); // the statistics read the array in its own type
 
-    t0 = Clock::now();
+    double statisticsSeconds = this->Seconds();
     const vtkSmartPointer<vtkIntArray> owner = NewVoxelOwnerArray(outputVector, geometry.Size());
     const ElementStatistics stats = ImageElementStatistics(ElementRasterizer(result.Mesh), array, parallel,
       AlgorithmProgress(this, 0.6, 0.95), owner ? owner->GetPointer(0) : nullptr);
@@ -165,24 +163,12 @@ int vtkImageMeshSmoothing::RequestData(
     }
     ElementQuality(result.Mesh, minAngle, radiusRatio, parallel);
     this->UpdateProgress(0.97);
-    const double statisticsSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    statisticsSeconds = this->Seconds() - statisticsSeconds;
     WriteImageMesh(result.Mesh, stats, minAngle, radiusRatio, output);
     AttachVoxelOwners(output, owner);
+    const vtkIdType nPts = input->GetNumberOfPoints();
     PassNodeArrays(input->GetPointData(), nPts, output->GetPointData(), result.Mesh.NumberOfPoints(), nPts);
-    const bool is2D = geometry.Is2D();
-    AddFieldValue(output, is2D ? names::MinAngleBefore : names::MinDihedralAngleBefore, before);
-    AddFieldValue(output, names::IterationsRun, result.IterationsRun);
-    AddFieldValue(output, names::SmoothingMoves, static_cast<double>(result.Moves));
-    AddFieldValue(output, names::EdgeFlips, static_cast<double>(result.Flips));
-    AddFieldValue(output, names::SliverMoves, static_cast<double>(result.Perturbed));
-    AddFieldValue(output, names::AddedNodes, static_cast<double>(result.AddedNodes));
-    AddFieldValue(output, names::SnappedNodes, static_cast<double>(result.SnappedNodes));
-    AddFieldValue(output, names::SmoothingSeconds, smoothingSeconds);
-    AddFieldValue(output, names::SweepSeconds, result.SweepSeconds);
-    AddFieldValue(output, names::RefinementSeconds, result.RefinementSeconds);
-    AddFieldValue(output, names::SliverSeconds, result.SliverSeconds);
-    AddFieldValue(output, names::StatisticsSeconds, statisticsSeconds);
-    AddFieldValue(output, names::TotalSeconds, std::chrono::duration<double>(Clock::now() - start).count());
+    AddSmoothingFields(output, result, geometry.Is2D(), before, smoothingSeconds, statisticsSeconds, this->Seconds());
     this->UpdateProgress(1.0);
     return 1;
   });

@@ -19,6 +19,7 @@
 #define vtkImageMeshSmoothing_h
 
 #include "FeatureMeshFiltersModule.h"
+#include "vtkFeatureMeshFilter.h" // the shared run and start-up
 #include "MeshSmoothing.h" // the parameters, declared once
 #include "vtkUnstructuredGridAlgorithm.h"
 
@@ -27,13 +28,14 @@
 class FEATUREMESHFILTERS_EXPORT vtkImageMeshSmoothing
   : public vtkUnstructuredGridAlgorithm
   , protected featuremesh::MeshSmoothingParameters
+  , protected featuremesh::FilterBase
 {
 public:
   static vtkImageMeshSmoothing* New();
   vtkTypeMacro(vtkImageMeshSmoothing, vtkUnstructuredGridAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
   /// Empty when the properties are usable, else the sentence Apply would fail with.
-  std::string ValidateProperties();
+  std::string ValidateProperties() override;
 
   enum Methods
   {
@@ -86,8 +88,6 @@ protected:
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
 private:
-  vtkMTimeType FailedAt = 0;
-  double FailedAtTime = 0.0;
   vtkImageMeshSmoothing(const vtkImageMeshSmoothing&) = delete;
   void operator=(const vtkImageMeshSmoothing&) = delete;
 };

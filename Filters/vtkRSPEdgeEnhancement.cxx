@@ -22,9 +22,62 @@
 #include <algorithm>
 #include <chrono>
 
+namespace
+{
+std::array<double, 3> VoxelCentre(const featuremesh::ImageGeometry& geometry, std::int64_t v)
+{
+  const std::array<int, 3> c = geometry.Coordinates(v);
+  return geometry.IndexToWorld({ { static_cast<double>(c[0]), static_cast<double>(c[1]), static_cast<double>(c[2]) } });
+}
+
+// Output 1: the closed contour through the voxels of `contour` (2D); false when there is none.
+bool WriteContour(const std::vector<std::int64_t>& contour, const featuremesh::ImageGeometry& geometry, vtkPolyData* output)
+{
+  if (contour.empty())
+  {
+    return false;
+  }
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> lines;
+  lines->InsertNextCell(static_cast<vtkIdType>(contour.size() + 1));
+  for (std::int64_t v : contour)
+  {
+    lines->InsertCellPoint(points->InsertNextPoint(VoxelCentre(geometry, v).data()));
+  }
+  lines->InsertCellPoint(0);
+  output->SetPoints(points);
+  output->SetLines(lines);
+  return true;
+}
+
+// Output 2: the paths' source and sink voxels as vertices, SampleRole 0 (source) or 1 (sink).
+void WriteSamples(const featuremesh::RSPResult& r, const featuremesh::ImageGeometry& geometry, vtkPolyData* output)
+{
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> verts;
+  vtkNew<vtkUnsignedCharArray> role;
+  role->SetName(featuremesh::names::SampleRole);
+  for (int kind = 0; kind < 2; ++kind)
+  {
+    for (std::int64_t v : kind == 0 ? r.SourceVoxels : r.SinkVoxels)
+    {
+      const vtkIdType id = points->InsertNextPoint(VoxelCentre(geometry, v).data());
+      verts->InsertNextCell(1, &id);
+      role->InsertNextValue(static_cast<unsigned char>(kind));
+    }
+  }
+  output->SetPoints(points);
+  output->SetVerts(verts);
+  output->GetPointData()->AddArray(role);
+}
+} // namespace
+
 vtkStandardNewMacro(vtkRSPEdgeEnhancement);
 
 vtkRSPEdgeEnhancement::vtkRSPEdgeEnhancement()
+  : featuremesh::FilterBase(this, "RSP Edge Enhancement")
 {
   this->SetNumberOfInputPorts(3);
   this->SetNumberOfOutputPorts(3);
@@ -111,62 +164,42 @@ void AddPointArray(vtkImageData* image, const char* name, const std::vector<T>& 
 
 int vtkRSPEdgeEnhancement::RequestData(vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return featuremesh::RunFilter(this, "RSP Edge Enhancement", outputVector, this->FailedAt, this->FailedAtTime, [&]() -> int {
+  return this->Run(outputVector, [&]() -> int {
     using namespace featuremesh;
-    const auto start = std::chrono::steady_clock::now();
     vtkSmartPointer<vtkImageData> image =
       VoxelValuedImage(vtkImageData::GetData(inputVector[0], 0), this->GetInputArrayInformation(0));
     vtkDataObject* objectSeeds = vtkDataObject::GetData(inputVector[1], 0);
     vtkDataObject* backgroundSeeds = vtkDataObject::GetData(inputVector[2], 0);
     vtkImageData* output = vtkImageData::GetData(outputVector, 0);
-    vtkPolyData* contourOutput = vtkPolyData::GetData(outputVector, 1);
-    vtkPolyData* samplesOutput = vtkPolyData::GetData(outputVector, 2);
-    std::string error, warning;
-    auto fail = [&](const std::string& why) {
-      vtkErrorMacro("RSP Edge Enhancement: " << why);
-      return 0;
-    };
-    if (IsEmptyPiece(outputVector, image))
+    if (const int done = this->Start(outputVector, { image }); done >= 0)
     {
-      return 1;
+      return done;
     }
     ImageGeometry geometry;
-    if (!ImageGeometryOf(image, geometry, error))
-    {
-      return fail(error);
-    }
-    const RSPParameters& p = *this;
-    error = this->ValidateProperties();
-    if (!error.empty())
-    {
-      return fail(error);
-    }
+    std::string error;
     std::vector<std::int64_t> objectVoxels, backgroundVoxels;
+    if (!this->Frame(image, geometry))
+    {
+      return 0;
+    }
     if (!ObjectAndBackgroundVoxels(objectSeeds, backgroundSeeds, geometry, objectVoxels, backgroundVoxels, error))
     {
-      return fail(error);
+      return this->Fail(error);
     }
     std::vector<float> storage;
-    vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
-    if (!warning.empty())
-    {
-      vtkWarningMacro("RSP Edge Enhancement: " << warning);
-    }
+    vtkDataArray* array = this->ChosenImageArray(image, this->GetInputArrayInformation(0));
     const float* values = array ? FloatValues(array, storage, error) : nullptr;
     if (!values)
     {
-      return fail(error);
+      return array ? this->Fail(error) : 0;
     }
     this->UpdateProgress(0.05);
+    const RSPParameters& p = *this;
     const RSPResult r = featuremesh::RSPEdgeEnhancement(
       values, geometry, objectVoxels, backgroundVoxels, p, SMPParallelFor(), AlgorithmProgress(this, 0.05, 0.95));
-    if (r.Aborted)
+    if (r.Aborted || !r.Error.empty())
     {
-      return 1;
-    }
-    if (!r.Error.empty())
-    {
-      return fail(r.Error);
+      return r.Aborted ? 1 : this->Fail(r.Error);
     }
 
     SetImageFrame(output, geometry);
@@ -183,67 +216,23 @@ int vtkRSPEdgeEnhancement::RequestData(vtkInformation*, vtkInformationVector** i
     {
       AddPointArray<vtkUnsignedCharArray>(output, names::ContourRegion, r.Region.empty() ? std::vector<std::uint8_t>(geometry.Size(), 0) : r.Region);
     }
-    const auto world = [&](std::int64_t v) {
-      const std::array<int, 3> c = geometry.Coordinates(v);
-      return geometry.IndexToWorld({ { static_cast<double>(c[0]), static_cast<double>(c[1]), static_cast<double>(c[2]) } });
-    };
-    if (!r.Contour.empty())
+    if (!WriteContour(r.Contour, geometry, vtkPolyData::GetData(outputVector, 1)) && geometry.Is2D())
     {
-      vtkNew<vtkPoints> points;
-      points->SetDataTypeToDouble();
-      vtkNew<vtkCellArray> lines;
-      lines->InsertNextCell(static_cast<vtkIdType>(r.Contour.size() + 1));
-      for (std::size_t i = 0; i < r.Contour.size(); ++i)
-      {
-        const auto x = world(r.Contour[i]);
-        lines->InsertCellPoint(points->InsertNextPoint(x.data()));
-      }
-      lines->InsertCellPoint(0);
-      contourOutput->SetPoints(points);
-      contourOutput->SetLines(lines);
+      this->Warn("the edge confidence draws no closed contour around the object seeds.");
     }
-    else if (geometry.Is2D())
-    {
-      vtkWarningMacro("RSP Edge Enhancement: the edge confidence draws no closed contour around the object seeds.");
-    }
-    {
-      vtkNew<vtkPoints> points;
-      points->SetDataTypeToDouble();
-      vtkNew<vtkCellArray> verts;
-      vtkNew<vtkUnsignedCharArray> role;
-      role->SetName(names::SampleRole);
-      for (int kind = 0; kind < 2; ++kind)
-      {
-        for (std::int64_t v : kind == 0 ? r.SourceVoxels : r.SinkVoxels)
-        {
-          const auto x = world(v);
-          const vtkIdType id = points->InsertNextPoint(x.data());
-          verts->InsertNextCell(1, &id);
-          role->InsertNextValue(static_cast<unsigned char>(kind));
-        }
-      }
-      samplesOutput->SetPoints(points);
-      samplesOutput->SetVerts(verts);
-      samplesOutput->GetPointData()->AddArray(role);
-    }
-    AddFieldValue(output, names::Paths, static_cast<double>(r.Paths));
-    AddFieldValue(output, names::PathVoxels, static_cast<double>(r.PathVoxels));
-    AddFieldValue(output, names::PathGridFactor, r.PathGridFactor);
-    AddFieldValue(output, names::ObjectThreshold, r.ObjectThreshold);
-    AddFieldValue(output, names::BackgroundThreshold, r.BackgroundThreshold);
-    AddFieldValue(output, names::GradientRange, r.GradientRange);
+    WriteSamples(r, geometry, vtkPolyData::GetData(outputVector, 2));
+    AddFieldValues(output, { { names::Paths, static_cast<double>(r.Paths) },
+                             { names::PathVoxels, static_cast<double>(r.PathVoxels) },
+                             { names::PathGridFactor, r.PathGridFactor }, { names::ObjectThreshold, r.ObjectThreshold },
+                             { names::BackgroundThreshold, r.BackgroundThreshold }, { names::GradientRange, r.GradientRange } });
     for (const auto& step : r.StepSeconds)
     {
-      if (step.first == "marching")
+      if (step.first == "marching" || step.first == "paths")
       {
-        AddFieldValue(output, names::MarchingSeconds, step.second);
-      }
-      else if (step.first == "paths")
-      {
-        AddFieldValue(output, names::PathSeconds, step.second);
+        AddFieldValue(output, step.first == "marching" ? names::MarchingSeconds : names::PathSeconds, step.second);
       }
     }
-    AddFieldValue(output, names::TotalSeconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    AddFieldValue(output, names::TotalSeconds, this->Seconds());
     this->UpdateProgress(1.0);
     return 1;
   });

@@ -15,6 +15,7 @@
 #define vtkRSPEdgeEnhancement_h
 
 #include "FeatureMeshFiltersModule.h"
+#include "vtkFeatureMeshFilter.h" // the shared run and start-up
 #include "RSPEdgeEnhancement.h" // the parameters, declared once
 #include "vtkImageAlgorithm.h"
 
@@ -23,13 +24,14 @@
 class FEATUREMESHFILTERS_EXPORT vtkRSPEdgeEnhancement
   : public vtkImageAlgorithm
   , protected featuremesh::RSPParameters
+  , protected featuremesh::FilterBase
 {
 public:
   static vtkRSPEdgeEnhancement* New();
   vtkTypeMacro(vtkRSPEdgeEnhancement, vtkImageAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
   /// Empty when the properties are usable, else the sentence Apply would fail with.
-  std::string ValidateProperties();
+  std::string ValidateProperties() override;
 
   /// beta of G = exp(-beta |grad I|), |grad I| in 8-bit grey levels per voxel (the image's 1st-99th
   /// percentile range mapped to 255). Default 0.1, the thesis's.
@@ -75,8 +77,6 @@ protected:
 
 
 private:
-  vtkMTimeType FailedAt = 0;
-  double FailedAtTime = 0.0;
   vtkRSPEdgeEnhancement(const vtkRSPEdgeEnhancement&) = delete;
   void operator=(const vtkRSPEdgeEnhancement&) = delete;
 };

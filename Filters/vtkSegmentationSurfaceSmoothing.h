@@ -17,6 +17,7 @@
 #define vtkSegmentationSurfaceSmoothing_h
 
 #include "FeatureMeshFiltersModule.h"
+#include "vtkFeatureMeshFilter.h" // the shared run and start-up
 #include "SurfaceSmoothing.h" // the parameters, declared once
 #include "vtkPolyDataAlgorithm.h"
 
@@ -25,13 +26,14 @@
 class FEATUREMESHFILTERS_EXPORT vtkSegmentationSurfaceSmoothing
   : public vtkPolyDataAlgorithm
   , protected featuremesh::SurfaceSmoothingParameters
+  , protected featuremesh::FilterBase
 {
 public:
   static vtkSegmentationSurfaceSmoothing* New();
   vtkTypeMacro(vtkSegmentationSurfaceSmoothing, vtkPolyDataAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
   /// Empty when the properties are usable, else the sentence Apply would fail with.
-  std::string ValidateProperties();
+  std::string ValidateProperties() override;
 
   enum Methods
   {
@@ -73,8 +75,6 @@ protected:
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
 private:
-  vtkMTimeType FailedAt = 0;
-  double FailedAtTime = 0.0;
   vtkSegmentationSurfaceSmoothing(const vtkSegmentationSurfaceSmoothing&) = delete;
   void operator=(const vtkSegmentationSurfaceSmoothing&) = delete;
 };

@@ -67,6 +67,7 @@ struct vtkSuperVoxelCut::MeshData
 vtkSuperVoxelCut::~vtkSuperVoxelCut() = default;
 
 vtkSuperVoxelCut::vtkSuperVoxelCut()
+  : featuremesh::FilterBase(this, "Super-Voxel Cut")
 {
   this->SetNumberOfInputPorts(5);
   this->SetNumberOfOutputPorts(3);
@@ -124,207 +125,180 @@ int vtkSuperVoxelCut::RequestUpdateExtent(
 int vtkSuperVoxelCut::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return featuremesh::RunFilter(this, "Super-Voxel Cut", outputVector, this->FailedAt, this->FailedAtTime, [&]() -> int {
+  return this->Run(outputVector, [&]() -> int {
     using namespace featuremesh;
-    using Clock = std::chrono::steady_clock;
-    const auto start = Clock::now();
     vtkUnstructuredGrid* input = vtkUnstructuredGrid::GetData(inputVector[0], 0);
     vtkDataObject* objectSeeds = vtkDataObject::GetData(inputVector[1], 0);
     vtkDataObject* backgroundSeeds = vtkDataObject::GetData(inputVector[2], 0);
     vtkSmartPointer<vtkImageData> image =
       VoxelValuedImage(vtkImageData::GetData(inputVector[3], 0), this->GetInputArrayInformation(0));
     vtkDataObject* labelledSeeds = vtkDataObject::GetData(inputVector[4], 0);
-    vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
-    vtkImageData* labelImage = vtkImageData::GetData(outputVector, 2);
-    std::string error, warning;
-    auto fail = [&](const std::string& why) {
-      vtkErrorMacro("Super-Voxel Cut: " << why);
-      return 0;
-    };
-
-    const SuperVoxelCutParameters& par = *this;
-    error = this->ValidateProperties();
-    if (!error.empty())
+    if (const int done = this->Start(outputVector, { input }); done >= 0)
     {
-      return fail(error);
-    }
-    if (IsEmptyPiece(outputVector, input))
-    {
-      return 1;
-    }
-    if (!input || input->GetNumberOfCells() == 0)
-    {
-      return fail("the mesh is empty.");
-    }
-    vtkDataArray* meanArray = input->GetCellData()->GetArray(names::MeanIntensity);
-    vtkDataArray* countArray = input->GetCellData()->GetArray(names::PixelCount);
-    if (!meanArray || !countArray)
-    {
-      return fail("the mesh has no MeanIntensity and PixelCount cell arrays; make it with Delaunay Image Mesh.");
+      return done;
     }
     // The image frame: the Image input when connected, else the mesh's field data.
+    std::string error = ImageMeshProblem(input);
+    if (!error.empty())
+    {
+      return this->Fail(error);
+    }
     ImageGeometry geometry;
-    if (image ? !ImageGeometryOf(image, geometry, error) : !ImageGeometryFromFieldData(input, geometry, error))
+    if (image ? !ImageGeometryOf(image, geometry, error) || !MeshMatchesImage(input, geometry, error)
+              : !ImageGeometryFromFieldData(input, geometry, error))
     {
-      return fail(image ? error : error + " Or connect the Image input.");
+      return this->Fail(image ? error : error + " Or connect the Image input.");
     }
-    if (image && !MeshMatchesImage(input, geometry, error))
+    vtkDataArray* valuesArray = image ? this->ChosenImageArray(image, this->GetInputArrayInformation(0)) : nullptr;
+    if (image && !valuesArray)
     {
-      return fail(error);
-    }
-    vtkDataArray* valuesArray = nullptr;
-    if (image)
-    {
-      valuesArray = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
-      if (!warning.empty())
-      {
-        vtkWarningMacro("Super-Voxel Cut: " << warning);
-      }
-      if (!valuesArray)
-      {
-        return fail(error);
-      }
+      return 0;
     }
     if (!labelledSeeds && (!objectSeeds || !backgroundSeeds))
     {
-      return fail("connect the Object Seeds and the Background Seeds, or labelled Seeds.");
+      return this->Fail("connect the Object Seeds and the Background Seeds, or labelled Seeds.");
     }
-    // A multi-channel image serves labelled seeds only; the binary preparation below leaves it out.
+    // A multi-channel image serves labelled seeds only; the binary preparation leaves it out.
     vtkDataArray* binaryValues = valuesArray && valuesArray->GetNumberOfComponents() == 1 ? valuesArray : nullptr;
     if (valuesArray && !binaryValues && !labelledSeeds)
     {
-      return fail("the image array has " + std::to_string(valuesArray->GetNumberOfComponents()) +
+      return this->Fail("the image array has " + std::to_string(valuesArray->GetNumberOfComponents()) +
         " components; a binary cut takes one (choose a one-component array), labelled Seeds take several.");
     }
-    // The mesh-dependent data: kept from the last run when the mesh, the image and its array are
-    // the same objects, unmodified (a seed edit).
-    MeshData key({ input->GetPoints(), input->GetCells(), meanArray, countArray, valuesArray }, geometry);
-    if (!this->Prepared || !this->Prepared->SameInputs(key))
+    if (const int done = this->Prepare(input, geometry, valuesArray, binaryValues); done >= 0)
     {
-      this->Prepared.reset();
-      auto prepared = std::make_unique<MeshData>(std::move(key));
-      if (!ToSimplexMesh(input, geometry, prepared->Mesh, error))
-      {
-        return fail(error);
-      }
-      const vtkIdType nCells = input->GetNumberOfCells();
-      prepared->Mean.resize(nCells);
-      prepared->Count.resize(nCells);
-      vtkIdType badMean = 0, badCount = 0;
-      for (vtkIdType c = 0; c < nCells; ++c)
-      {
-        const double mean = prepared->Mean[c] = meanArray->GetComponent(c, 0);
-        const double count = prepared->Count[c] = countArray->GetComponent(c, 0);
-        badMean += std::isfinite(mean) ? 0 : 1;
-        badCount += std::isfinite(count) && count >= 0 ? 0 : 1;
-      }
-      if (badMean || badCount)
-      {
-        return fail("the mesh's " + std::string(badMean ? "MeanIntensity" : "PixelCount") + " cell array holds " +
-          std::to_string(badMean ? badMean : badCount) +
-          (badMean ? " NaN or infinite values" : " negative or non-finite values") + "; recompute the mesh with Delaunay Image Mesh.");
-      }
-      // The image is read in its own type (checked as ToDouble would, without the copy).
-      if (binaryValues && !CheckDouble(binaryValues, error))
-      {
-        return fail(error);
-      }
-      this->UpdateProgress(0.1);
-      // Stage 2's or 3's owner map, when it was made for this mesh in this frame.
-      ImageGeometry meshFrame;
-      std::string ignored;
-      if (ImageGeometryFromFieldData(input, meshFrame, ignored) && SameFrame(meshFrame, geometry))
-      {
-        prepared->OwnerMapReused = AttachedVoxelOwners(input, geometry.Size(), prepared->Cut.Owner);
-      }
-      const ProgressFunction progress = AlgorithmProgress(this, 0.1, 0.4);
-      bool ready = false;
-      if (!binaryValues)
-      {
-        ready = PrepareSuperVoxelCut(prepared->Mesh, static_cast<const double*>(nullptr), prepared->Cut, error, SMPParallelFor(), progress);
-      }
-      else
-      {
-        switch (binaryValues->GetDataType())
-        {
-          vtkTemplateMacro(ready = PrepareSuperVoxelCut(prepared->Mesh, static_cast<const VTK_TT*>(binaryValues->GetVoidPointer(0)),
-                             prepared->Cut, error, SMPParallelFor(), progress,
-                             std::make_shared<vtkSmartPointer<vtkDataArray>>(binaryValues)));
-          default:
-            error = "the array's value type is not supported.";
-        }
-      }
-      if (!ready)
-      {
-        return error.empty() ? 1 : fail(error); // aborted, or a bad value
-      }
-      this->Prepared = std::move(prepared);
+      return done;
     }
-    MeshData& data = *this->Prepared;
-    const SimplexMesh& mesh = data.Mesh;
     std::vector<std::int64_t> objectVoxels, backgroundVoxels;
     if (labelledSeeds)
     {
       LabelledSeeds seeds;
       if (!LabelledSeedVoxels(labelledSeeds, this->SeedLabelArray.c_str(), geometry, seeds, error))
       {
-        return fail(error);
-      }
-      if (!(std::count(seeds.Label.begin(), seeds.Label.end(), 0) + std::count(seeds.Label.begin(), seeds.Label.end(), 1) ==
-              static_cast<std::ptrdiff_t>(seeds.Label.size()) && binaryValues == valuesArray))
-      {
-        return this->RequestMultiLabel(input, seeds, valuesArray, par, outputVector);
+        return this->Fail(error);
       }
       // One object on one channel: alpha-expansion with two labels is the binary cut.
-      for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
+      if (binaryValues != valuesArray || !BinarySeedVoxels(seeds, objectVoxels, backgroundVoxels))
       {
-        (seeds.Label[s] ? objectVoxels : backgroundVoxels).push_back(seeds.Voxel[s]);
+        return this->RequestMultiLabel(input, seeds, valuesArray, *this, outputVector);
       }
     }
     else if (!ObjectAndBackgroundVoxels(objectSeeds, backgroundSeeds, geometry, objectVoxels, backgroundVoxels, error))
     {
-      return fail(error);
+      return this->Fail(error);
     }
     this->UpdateProgress(0.45);
-    const ParallelFor parallel = SMPParallelFor();
     VoxelValueFunction voxelValue;
     if (binaryValues)
     {
       voxelValue = [binaryValues](std::int64_t v) { return binaryValues->GetComponent(v, 0); };
     }
-    const SuperVoxelCutResult result = featuremesh::SuperVoxelCut(mesh, data.Cut, data.Mean, data.Count, objectVoxels,
-      backgroundVoxels, voxelValue, par, parallel, AlgorithmProgress(this, 0.45, 0.95), &data.Flow);
-    if (result.Aborted)
+    MeshData& data = *this->Prepared;
+    const SuperVoxelCutResult result = featuremesh::SuperVoxelCut(data.Mesh, data.Cut, data.Mean, data.Count,
+      objectVoxels, backgroundVoxels, voxelValue, *this, SMPParallelFor(), AlgorithmProgress(this, 0.45, 0.95), &data.Flow);
+    if (result.Aborted || !result.Error.empty())
     {
-      return 1;
-    }
-    if (!result.Error.empty())
-    {
-      return fail(result.Error);
+      return result.Aborted ? 1 : this->Fail(result.Error);
     }
     this->UpdateProgress(0.95);
     const CutResult& cut = result.Cut;
-
     this->WriteLabels(input, cut.Label, result.BoundaryFaces, outputVector);
-
-    const auto objectElements = std::count(cut.Label.begin(), cut.Label.end(), LabelObject);
-    for (vtkDataObject* d : { static_cast<vtkDataObject*>(output), static_cast<vtkDataObject*>(labelImage) })
-    {
-      AddFieldValue(d, names::Sigma, cut.Sigma);
-      AddFieldValue(d, names::Bins, cut.Bins);
-      AddFieldValue(d, names::Flow, cut.Flow);
-      AddFieldValue(d, names::ObjectElements, static_cast<double>(objectElements));
-      AddObjectComponents(d, cut.ObjectComponentVoxels, geometry.VoxelVolume(), cut.ConnectivityChanged);
-      AddFieldValue(d, names::SetupSeconds, result.SetupSeconds);
-      AddFieldValue(d, names::OwnerMapReused, this->Prepared->OwnerMapReused ? 1.0 : 0.0);
-      AddFieldValue(d, names::GraphSeconds, cut.GraphSeconds);
-      AddFieldValue(d, names::FlowSeconds, cut.FlowSeconds);
-      AddFieldValue(d, names::GeodesicSeconds, cut.GeodesicSeconds);
-      AddFieldValue(d, names::CutTotalSeconds, std::chrono::duration<double>(Clock::now() - start).count());
-    }
+    this->WriteCutFields(result, geometry.VoxelVolume(), outputVector);
     this->UpdateProgress(1.0);
     return 1;
   });
+}
+
+void vtkSuperVoxelCut::WriteCutFields(
+  const featuremesh::SuperVoxelCutResult& result, double voxelVolume, vtkInformationVector* outputVector)
+{
+  using namespace featuremesh;
+  const CutResult& cut = result.Cut;
+  const auto objectElements = std::count(cut.Label.begin(), cut.Label.end(), LabelObject);
+  for (vtkDataObject* d : { vtkDataObject::GetData(outputVector, 0), vtkDataObject::GetData(outputVector, 2) })
+  {
+    AddFieldValues(d, { { names::Sigma, cut.Sigma }, { names::Bins, cut.Bins }, { names::Flow, cut.Flow },
+                        { names::ObjectElements, static_cast<double>(objectElements) } });
+    AddObjectComponents(d, cut.ObjectComponentVoxels, voxelVolume, cut.ConnectivityChanged);
+    AddFieldValues(d, { { names::SetupSeconds, result.SetupSeconds },
+                        { names::OwnerMapReused, this->Prepared->OwnerMapReused ? 1.0 : 0.0 },
+                        { names::GraphSeconds, cut.GraphSeconds }, { names::FlowSeconds, cut.FlowSeconds },
+                        { names::GeodesicSeconds, cut.GeodesicSeconds }, { names::CutTotalSeconds, this->Seconds() } });
+  }
+}
+
+int vtkSuperVoxelCut::Prepare(vtkUnstructuredGrid* input, const featuremesh::ImageGeometry& geometry,
+  vtkDataArray* valuesArray, vtkDataArray* binaryValues)
+{
+  using namespace featuremesh;
+  vtkDataArray* meanArray = input->GetCellData()->GetArray(names::MeanIntensity);
+  vtkDataArray* countArray = input->GetCellData()->GetArray(names::PixelCount);
+  // Kept from the last run when the mesh, the image and its array are the same objects, unmodified (a seed edit).
+  MeshData key({ input->GetPoints(), input->GetCells(), meanArray, countArray, valuesArray }, geometry);
+  if (this->Prepared && this->Prepared->SameInputs(key))
+  {
+    return -1;
+  }
+  this->Prepared.reset();
+  auto prepared = std::make_unique<MeshData>(std::move(key));
+  std::string error;
+  if (!ToSimplexMesh(input, geometry, prepared->Mesh, error))
+  {
+    return this->Fail(error);
+  }
+  const vtkIdType nCells = input->GetNumberOfCells();
+  prepared->Mean.resize(nCells);
+  prepared->Count.resize(nCells);
+  vtkIdType badMean = 0, badCount = 0;
+  for (vtkIdType c = 0; c < nCells; ++c)
+  {
+    const double mean = prepared->Mean[c] = meanArray->GetComponent(c, 0);
+    const double count = prepared->Count[c] = countArray->GetComponent(c, 0);
+    badMean += std::isfinite(mean) ? 0 : 1;
+    badCount += std::isfinite(count) && count >= 0 ? 0 : 1;
+  }
+  if (badMean || badCount)
+  {
+    return this->Fail("the mesh's " + std::string(badMean ? "MeanIntensity" : "PixelCount") + " cell array holds " +
+      std::to_string(badMean ? badMean : badCount) +
+      (badMean ? " NaN or infinite values" : " negative or non-finite values") + "; recompute the mesh with Delaunay Image Mesh.");
+  }
+  // The image is read in its own type (checked as ToDouble would, without the copy).
+  if (binaryValues && !CheckDouble(binaryValues, error))
+  {
+    return this->Fail(error);
+  }
+  this->UpdateProgress(0.1);
+  // Stage 2's or 3's owner map, when it was made for this mesh in this frame.
+  ImageGeometry meshFrame;
+  std::string ignored;
+  if (ImageGeometryFromFieldData(input, meshFrame, ignored) && SameFrame(meshFrame, geometry))
+  {
+    prepared->OwnerMapReused = AttachedVoxelOwners(input, geometry.Size(), prepared->Cut.Owner);
+  }
+  const ProgressFunction progress = AlgorithmProgress(this, 0.1, 0.4);
+  bool ready = false;
+  if (!binaryValues)
+  {
+    ready = PrepareSuperVoxelCut(prepared->Mesh, static_cast<const double*>(nullptr), prepared->Cut, error, SMPParallelFor(), progress);
+  }
+  else
+  {
+    switch (binaryValues->GetDataType())
+    {
+      vtkTemplateMacro(ready = PrepareSuperVoxelCut(prepared->Mesh, static_cast<const VTK_TT*>(binaryValues->GetVoidPointer(0)),
+                         prepared->Cut, error, SMPParallelFor(), progress,
+                         std::make_shared<vtkSmartPointer<vtkDataArray>>(binaryValues)));
+      default:
+        error = "the array's value type is not supported.";
+    }
+  }
+  if (!ready)
+  {
+    return error.empty() ? 1 : this->Fail(error); // aborted, or a bad value
+  }
+  this->Prepared = std::move(prepared);
+  return -1;
 }
 
 void vtkSuperVoxelCut::WriteLabels(vtkUnstructuredGrid* input, const std::vector<std::uint8_t>& labels,
@@ -372,12 +346,9 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
   vtkDataArray* values, const featuremesh::SuperVoxelCutParameters& par, vtkInformationVector* outputVector)
 {
   using namespace featuremesh;
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
   if (!values)
   {
-    vtkErrorMacro("Super-Voxel Cut: labelled seeds with more than one object need the Image input.");
-    return 0;
+    return this->Fail("labelled seeds with more than one object need the Image input.");
   }
   MeshData& data = *this->Prepared;
   const SimplexMesh& mesh = data.Mesh;
@@ -410,8 +381,7 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
     if (!binned)
     {
       data.Bins = ChannelBins();
-      vtkErrorMacro("Super-Voxel Cut: " << error);
-      return 0;
+      return this->Fail(error);
     }
     data.Runs = GroupNodeBins(data.Cut.Owner.data(), data.Bins, mesh.NumberOfElements());
     data.Multi.Clear();
@@ -420,24 +390,16 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
   const MultiLabelParameters& multi = *this;
   const MultiLabelResult result = MultiLabelSuperVoxelCut(mesh, data.Cut, data.Bins, data.Runs, data.ChannelMean,
     data.ChannelCount, seeds, par, multi, parallel, AlgorithmProgress(this, 0.45, 0.95), &data.Multi);
-  if (result.Aborted)
+  if (result.Aborted || !result.Error.empty())
   {
-    return 1;
-  }
-  if (!result.Error.empty())
-  {
-    vtkErrorMacro("Super-Voxel Cut: " << result.Error);
-    return 0;
+    return result.Aborted ? 1 : this->Fail(result.Error);
   }
   this->WriteLabels(input, result.Label, result.BoundaryFaces, outputVector);
-  vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
-  vtkImageData* labelImage = vtkImageData::GetData(outputVector, 2);
-  for (vtkDataObject* d : { static_cast<vtkDataObject*>(output), static_cast<vtkDataObject*>(labelImage) })
+  for (vtkDataObject* d : { vtkDataObject::GetData(outputVector, 0), vtkDataObject::GetData(outputVector, 2) })
   {
     AddMultiLabelFields(d, result, this->LabelNames);
-    AddFieldValue(d, names::SetupSeconds, result.SetupSeconds);
-    AddFieldValue(d, names::OwnerMapReused, this->Prepared->OwnerMapReused ? 1.0 : 0.0);
-    AddFieldValue(d, names::CutTotalSeconds, std::chrono::duration<double>(Clock::now() - start).count());
+    AddFieldValues(d, { { names::SetupSeconds, result.SetupSeconds },
+                        { names::OwnerMapReused, data.OwnerMapReused ? 1.0 : 0.0 }, { names::CutTotalSeconds, this->Seconds() } });
   }
   this->UpdateProgress(1.0);
   return 1;

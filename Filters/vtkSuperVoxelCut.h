@@ -19,6 +19,7 @@
 
 #include "Contract.h"
 #include "FeatureMeshFiltersModule.h"
+#include "vtkFeatureMeshFilter.h" // the shared run and start-up
 #include "MultiLabelCut.h" // the parameters, declared once
 #include "SuperVoxelCut.h"
 #include "vtkUnstructuredGridAlgorithm.h"
@@ -36,13 +37,14 @@ class FEATUREMESHFILTERS_EXPORT vtkSuperVoxelCut
   : public vtkUnstructuredGridAlgorithm
   , protected featuremesh::SuperVoxelCutParameters
   , protected featuremesh::MultiLabelParameters
+  , protected featuremesh::FilterBase
 {
 public:
   static vtkSuperVoxelCut* New();
   vtkTypeMacro(vtkSuperVoxelCut, vtkUnstructuredGridAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
   /// Empty when the properties are usable, else the sentence Apply would fail with.
-  std::string ValidateProperties();
+  std::string ValidateProperties() override;
 
   /// Histogram bins; 0 = automatic (64).
   vtkSetMacro(Bins, int);
@@ -122,6 +124,11 @@ private:
   // The three outputs from the elements' labels and the boundary faces between them.
   void WriteLabels(vtkUnstructuredGrid* input, const std::vector<std::uint8_t>& labels,
     const std::vector<std::int64_t>& boundaryFaces, vtkInformationVector* outputVector);
+  // Makes (or keeps, for a seed edit) the mesh-dependent data: -1 to go on, else RequestData's result.
+  int Prepare(vtkUnstructuredGrid* input, const featuremesh::ImageGeometry& geometry, vtkDataArray* valuesArray,
+    vtkDataArray* binaryValues);
+  // The binary cut's field data on the labelled mesh and the label image.
+  void WriteCutFields(const featuremesh::SuperVoxelCutResult& result, double voxelVolume, vtkInformationVector* outputVector);
   // The cut with labelled seeds on the Seeds input.
   int RequestMultiLabel(vtkUnstructuredGrid* input, const featuremesh::LabelledSeeds& seeds, vtkDataArray* values,
     const featuremesh::SuperVoxelCutParameters& parameters, vtkInformationVector* outputVector);
@@ -130,9 +137,6 @@ private:
   // re-runs only the cut.
   struct MeshData;
   std::unique_ptr<MeshData> Prepared;
-  // The pipeline state of the last failed run (0: none), so that it is not repeated.
-  vtkMTimeType FailedAt = 0;
-  double FailedAtTime = 0.0;
   vtkSuperVoxelCut(const vtkSuperVoxelCut&) = delete;
   void operator=(const vtkSuperVoxelCut&) = delete;
 };

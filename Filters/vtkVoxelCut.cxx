@@ -24,6 +24,7 @@
 vtkStandardNewMacro(vtkVoxelCut);
 
 vtkVoxelCut::vtkVoxelCut()
+  : featuremesh::FilterBase(this, "Voxel Cut")
 {
   this->SetNumberOfInputPorts(4);
   this->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
@@ -61,96 +62,66 @@ int vtkVoxelCut::RequestUpdateExtent(vtkInformation*, vtkInformationVector** inp
 
 int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  return featuremesh::RunFilter(this, "Voxel Cut", outputVector, this->FailedAt, this->FailedAtTime, [&]() -> int {
+  return this->Run(outputVector, [&]() -> int {
     using namespace featuremesh;
-    const auto start = std::chrono::steady_clock::now();
     vtkSmartPointer<vtkImageData> image =
       VoxelValuedImage(vtkImageData::GetData(inputVector[0], 0), this->GetInputArrayInformation(0));
     vtkDataObject* objectSeeds = vtkDataObject::GetData(inputVector[1], 0);
     vtkDataObject* backgroundSeeds = vtkDataObject::GetData(inputVector[2], 0);
     vtkDataObject* labelledSeeds = vtkDataObject::GetData(inputVector[3], 0);
     vtkImageData* output = vtkImageData::GetData(outputVector, 0);
-    std::string error, warning;
-    auto fail = [&](const std::string& why) {
-      vtkErrorMacro("Voxel Cut: " << why);
-      return 0;
-    };
-    ImageGeometry geometry;
-    if (IsEmptyPiece(outputVector, image))
+    if (const int done = this->Start(outputVector, { image }); done >= 0)
     {
-      return 1;
+      return done;
     }
-    if (!ImageGeometryOf(image, geometry, error))
+    ImageGeometry geometry;
+    vtkDataArray* array = this->Frame(image, geometry) ? this->ChosenImageArray(image, this->GetInputArrayInformation(0)) : nullptr;
+    if (!array)
     {
-      return fail(error);
+      return 0;
     }
     const VoxelCutParameters& par = *this;
-    error = this->ValidateProperties();
-    if (!error.empty())
-    {
-      return fail(error);
-    }
+    std::string error;
     std::vector<std::int64_t> objectVoxels, backgroundVoxels;
     if (labelledSeeds)
     {
       LabelledSeeds seeds;
       if (!LabelledSeedVoxels(labelledSeeds, this->SeedLabelArray.c_str(), geometry, seeds, error))
       {
-        return fail(error);
-      }
-      vtkDataArray* array = ChosenArray(image, this->GetInputArrayInformation(0), error, warning);
-      if (!array)
-      {
-        return fail(error);
-      }
-      if (*std::max_element(seeds.Label.begin(), seeds.Label.end()) > 1 || array->GetNumberOfComponents() > 1)
-      {
-        return this->RequestMultiLabel(seeds, array, geometry, par, outputVector);
+        return this->Fail(error);
       }
       // One object on one channel: alpha-expansion with two labels is the binary cut.
-      for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
+      if (array->GetNumberOfComponents() > 1 || !BinarySeedVoxels(seeds, objectVoxels, backgroundVoxels))
       {
-        (seeds.Label[s] ? objectVoxels : backgroundVoxels).push_back(seeds.Voxel[s]);
+        return this->RequestMultiLabel(seeds, array, geometry, par, outputVector);
       }
     }
     else if (!objectSeeds || !backgroundSeeds)
     {
-      return fail("connect the Object Seeds and the Background Seeds, or labelled Seeds.");
+      return this->Fail("connect the Object Seeds and the Background Seeds, or labelled Seeds.");
     }
     else if (!ObjectAndBackgroundVoxels(objectSeeds, backgroundSeeds, geometry, objectVoxels, backgroundVoxels, error))
     {
-      return fail(error);
+      return this->Fail(error);
     }
     std::vector<double> values;
-    const bool valuesOk = ChosenValues(image, this->GetInputArrayInformation(0), values, error, warning);
-    if (!warning.empty())
+    if (!ToDouble(array, values, error))
     {
-      vtkWarningMacro("Voxel Cut: " << warning);
-    }
-    if (!valuesOk)
-    {
-      return fail(error);
+      return this->Fail(error);
     }
     this->UpdateProgress(0.2);
     const CutResult cut = featuremesh::VoxelCut(
       std::move(values), geometry, objectVoxels, backgroundVoxels, par, AlgorithmProgress(this, 0.2, 0.95));
-    if (cut.Aborted)
+    if (cut.Aborted || !cut.Error.empty())
     {
-      return 1;
-    }
-    if (!cut.Error.empty())
-    {
-      return fail(cut.Error);
+      return cut.Aborted ? 1 : this->Fail(cut.Error);
     }
     SetLabelImage(output, geometry, cut.Label);
-    AddFieldValue(output, names::Sigma, cut.Sigma);
-    AddFieldValue(output, names::Bins, cut.Bins);
-    AddFieldValue(output, names::Flow, cut.Flow);
-    AddFieldValue(output, names::GraphSeconds, cut.GraphSeconds);
-    AddFieldValue(output, names::FlowSeconds, cut.FlowSeconds);
-    AddFieldValue(output, names::GeodesicSeconds, cut.GeodesicSeconds);
+    AddFieldValues(output, { { names::Sigma, cut.Sigma }, { names::Bins, cut.Bins }, { names::Flow, cut.Flow },
+                             { names::GraphSeconds, cut.GraphSeconds }, { names::FlowSeconds, cut.FlowSeconds },
+                             { names::GeodesicSeconds, cut.GeodesicSeconds } });
     AddObjectComponents(output, cut.ObjectComponentVoxels, geometry.VoxelVolume(), cut.ConnectivityChanged);
-    AddFieldValue(output, names::TotalSeconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    AddFieldValue(output, names::TotalSeconds, this->Seconds());
     this->UpdateProgress(1.0);
     return 1;
   });
@@ -160,7 +131,6 @@ int vtkVoxelCut::RequestMultiLabel(const featuremesh::LabelledSeeds& seeds, vtkD
   const featuremesh::ImageGeometry& geometry, const featuremesh::VoxelCutParameters& par, vtkInformationVector* outputVector)
 {
   using namespace featuremesh;
-  const auto start = std::chrono::steady_clock::now();
   const int channels = array->GetNumberOfComponents();
   const std::int64_t n = geometry.Size();
   ChannelBins bins;
@@ -179,26 +149,20 @@ int vtkVoxelCut::RequestMultiLabel(const featuremesh::LabelledSeeds& seeds, vtkD
   }
   if (!binned)
   {
-    vtkErrorMacro("Voxel Cut: " << error);
-    return 0;
+    return this->Fail(error);
   }
   this->UpdateProgress(0.2);
   const MultiLabelParameters& multi = *this;
   const MultiLabelResult result =
     MultiLabelVoxelCut(values, bins, geometry, seeds, par, multi, AlgorithmProgress(this, 0.2, 0.95));
-  if (result.Aborted)
+  if (result.Aborted || !result.Error.empty())
   {
-    return 1;
-  }
-  if (!result.Error.empty())
-  {
-    vtkErrorMacro("Voxel Cut: " << result.Error);
-    return 0;
+    return result.Aborted ? 1 : this->Fail(result.Error);
   }
   vtkImageData* output = vtkImageData::GetData(outputVector, 0);
   SetLabelImage(output, geometry, result.Label);
   AddMultiLabelFields(output, result, this->LabelNames);
-  AddFieldValue(output, names::TotalSeconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  AddFieldValue(output, names::TotalSeconds, this->Seconds());
   this->UpdateProgress(1.0);
   return 1;
 }

@@ -14,6 +14,7 @@
 
 #include "Contract.h"
 #include "FeatureMeshFiltersModule.h"
+#include "vtkFeatureMeshFilter.h" // the shared run and start-up
 #include "MultiLabelCut.h" // the parameters, declared once
 #include "SuperVoxelCut.h"
 #include "vtkImageAlgorithm.h"
@@ -28,13 +29,14 @@ class FEATUREMESHFILTERS_EXPORT vtkVoxelCut
   : public vtkImageAlgorithm
   , protected featuremesh::VoxelCutParameters
   , protected featuremesh::MultiLabelParameters
+  , protected featuremesh::FilterBase
 {
 public:
   static vtkVoxelCut* New();
   vtkTypeMacro(vtkVoxelCut, vtkImageAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
   /// Empty when the properties are usable, else the sentence Apply would fail with.
-  std::string ValidateProperties();
+  std::string ValidateProperties() override;
 
   /// Histogram bins; 0 = automatic (64).
   vtkSetMacro(Bins, int);
@@ -93,9 +95,6 @@ private:
   int RequestMultiLabel(const featuremesh::LabelledSeeds& seeds, vtkDataArray* array,
     const featuremesh::ImageGeometry& geometry, const featuremesh::VoxelCutParameters& parameters,
     vtkInformationVector* outputVector);
-  // The pipeline state of the last failed run (0: none), so that it is not repeated.
-  vtkMTimeType FailedAt = 0;
-  double FailedAtTime = 0.0;
   vtkVoxelCut(const vtkVoxelCut&) = delete;
   void operator=(const vtkVoxelCut&) = delete;
 };

@@ -1,7 +1,8 @@
 // Every numeric property default in the plugin's XML equals the default of the VTK filter it sets
 // (which the filters take from the Core parameter structs): one source of truth, checked. And every
 // value an XML domain offers (range ends, enumeration entries) passes the filter's
-// ValidateProperties, the Core's ValidateParameters: the two range checks agree.
+// ValidateProperties, the Core's ValidateParameters: the two range checks agree. And each filter's
+// PrintSelf names every property its XML sets.
 #include "vtkDelaunayImageMesh.h"
 #include "vtkImageMeshSmoothing.h"
 #include "vtkFeatureNodes.h"
@@ -52,6 +53,15 @@ struct Property
       return std::string(value ? value : "");                                                      \
     }                                                                                              \
   }
+
+template <typename Filter>
+std::string Printed()
+{
+  vtkNew<Filter> filter;
+  std::ostringstream os;
+  filter->Print(os);
+  return os.str();
+}
 
 int main(int argc, char* argv[])
 {
@@ -212,6 +222,22 @@ int main(int argc, char* argv[])
           std::cout << "ok: " << key << " = " << cxx << "\n";
         }
       }
+    }
+  }
+  const std::map<std::string, std::string> printed = { { "vtkFeatureNodes", Printed<vtkFeatureNodes>() },
+    { "vtkDelaunayImageMesh", Printed<vtkDelaunayImageMesh>() }, { "vtkImageMeshSmoothing", Printed<vtkImageMeshSmoothing>() },
+    { "vtkRSPEdgeEnhancement", Printed<vtkRSPEdgeEnhancement>() }, { "vtkSuperVoxelCut", Printed<vtkSuperVoxelCut>() },
+    { "vtkVoxelCut", Printed<vtkVoxelCut>() },
+    { "vtkSegmentationSurfaceSmoothing", Printed<vtkSegmentationSurfaceSmoothing>() } };
+  for (const std::string& key : seen)
+  {
+    const std::string cls = key.substr(0, key.find("::")), name = key.substr(key.find("::") + 2);
+    const auto it = printed.find(cls);
+    ++checked;
+    if (it == printed.end() || it->second.find(name + ": ") == std::string::npos)
+    {
+      std::cout << "FAIL: " << cls << "::PrintSelf does not print " << name << "\n";
+      ++failures;
     }
   }
   std::set<std::string> keys;
