@@ -39,13 +39,11 @@ import tempfile
 import time
 
 import numpy as np
-from paraview import servermanager as sm
 import paraview.simple as ps
 from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-import featuremesh as fm  # noqa: E402
-from featuremesh import metrics, report  # noqa: E402
+import featuremesh as fm
+from featuremesh import metrics, report
 
 CONNECTIVITY = {0: "off", 1: "fill", 2: "seeded"}
 

@@ -22,16 +22,14 @@ import argparse
 import csv
 import os
 import statistics
-import sys
 import time
 
 import numpy as np
 from scipy import ndimage as ndi
 import paraview.simple as ps
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-import featuremesh as fm  # noqa: E402
-from featuremesh import metrics, report  # noqa: E402
+import featuremesh as fm
+from featuremesh import metrics, report
 
 METHODS = ("supervoxel", "voxel", "random_walker", "watershed")
 

@@ -18,7 +18,6 @@ Writes OUT.md and OUT.csv (a row per case, method and label).
 import argparse
 import csv
 import os
-import sys
 import tempfile
 import time
 
@@ -26,9 +25,8 @@ import numpy as np
 from scipy import ndimage as ndi
 import paraview.simple as ps
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-import featuremesh as fm  # noqa: E402
-from featuremesh import metrics, report  # noqa: E402
+import featuremesh as fm
+from featuremesh import metrics, report
 
 
 def seed_index(image, rows):

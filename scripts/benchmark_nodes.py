@@ -8,15 +8,13 @@ Issue 2 targets on a 2-core machine: 512x512 <= 15 ms, BraTS (240x240x155) <= 60
 import argparse
 import os
 import statistics
-import sys
 import time
 
 from paraview import servermanager as sm
 from paraview.simple import *  # noqa: F401,F403
 import paraview.simple as ps
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-import featuremesh as fm  # noqa: E402
+import featuremesh as fm
 
 def main():
     ap = argparse.ArgumentParser()

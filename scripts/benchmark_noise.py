@@ -12,7 +12,6 @@ Writes OUT.md and OUT.csv.
 """
 import argparse
 import os
-import sys
 import time
 
 import numpy as np
@@ -20,9 +19,8 @@ import paraview.simple as ps
 from vtkmodules.util.numpy_support import numpy_to_vtk
 from vtkmodules.vtkCommonDataModel import vtkImageData
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-import featuremesh as fm  # noqa: E402
-from featuremesh.report import machine, write_table  # noqa: E402
+import featuremesh as fm
+from featuremesh.report import machine, write_table
 
 KEYS = ["case", "level", "noise_sigma", "floor", "estimated_sigma", "nodes", "canny", "halftone", "elements", "seconds",
         "dice_supervoxel", "dice_voxel"]

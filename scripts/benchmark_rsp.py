@@ -16,7 +16,6 @@ import argparse
 import csv
 import os
 import statistics
-import sys
 import time
 
 import numpy as np
@@ -24,9 +23,8 @@ import paraview.simple as ps
 from scipy import ndimage
 from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-import featuremesh as fm  # noqa: E402
-from featuremesh import metrics  # noqa: E402
+import featuremesh as fm
+from featuremesh import metrics
 
 
 def parse(text):

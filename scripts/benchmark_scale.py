@@ -21,9 +21,8 @@ import sys
 import tempfile
 import time
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-from featuremesh import report  # noqa: E402
-from featuremesh.report import write_table  # noqa: E402
+from featuremesh import report
+from featuremesh.report import write_table
 
 SIZES = (("1x", None), ("2x", 2.0 ** (1.0 / 3.0)), ("512^3", 512))
 

@@ -12,17 +12,14 @@ majority reference label), elements owning no voxel, and the smoothing filter's 
 import argparse
 import os
 import statistics
-import sys
 import time
 
-import numpy as np
 import paraview.simple as ps
 from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-import featuremesh as fm  # noqa: E402
-from featuremesh.report import write_table  # noqa: E402
-from featuremesh import metrics  # noqa: E402
+import featuremesh as fm
+from featuremesh.report import write_table
+from featuremesh import metrics
 
 
 def quality(mesh):

@@ -17,14 +17,12 @@ import argparse
 import csv
 import os
 import statistics
-import sys
 
 import paraview.simple as ps
 from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-import featuremesh as fm  # noqa: E402
-from featuremesh import metrics  # noqa: E402
+import featuremesh as fm
+from featuremesh import metrics
 
 VARIANTS = [("Laplacian 3", dict(Method=0, Iterations=3)), ("Taubin 3", dict(Method=1, Iterations=3)),
             ("Taubin 10", dict(Method=1, Iterations=10)), ("Laplacian 1", dict(Method=0, Iterations=1))]

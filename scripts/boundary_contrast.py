@@ -12,7 +12,6 @@ features alone can get there.
 """
 import argparse
 import os
-import sys
 
 import numpy as np
 from scipy import ndimage
@@ -23,8 +22,7 @@ from vtkmodules.util.numpy_support import numpy_to_vtk as n2v
 from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 from vtkmodules.vtkCommonDataModel import vtkImageData
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-import featuremesh as fm  # noqa: E402
+import featuremesh as fm
 
 def largest_abs_hessian_eigenvalue(a, sigma):
     axes = range(a.ndim)

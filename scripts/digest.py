@@ -11,11 +11,8 @@ also with the CGAL backend. Compare two runs with diff.
 """
 import argparse
 import hashlib
-import os
-import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-import featuremesh as fm  # noqa: E402
+import featuremesh as fm
 
 # Cell arrays by value, in a fixed order; the quality array was once called Quality.
 N = fm.names

@@ -18,13 +18,12 @@ report gives Dice per label.
 Writes DIR/<name>_mesh.vtu (the cut's labelled mesh), _boundary.vtp (the smoothed boundary),
 _labels.vti, _fem.vtu (the labelled mesh with the smoothed interface) and the same mesh for FEM codes:
 _fem.msh (Gmsh 2.2), _fem.mesh (Medit), _fem.inp (Abaqus), _fem.exo (Exodus II), with region and
-boundary tags as python/featuremesh/fem.py lists them; _report.json (also printed), _view.png and
+boundary tags as scripts/featuremesh/fem.py lists them; _report.json (also printed), _view.png and
 _quality.png (the quality histogram per label).
 """
 import argparse
 import json
 import os
-import sys
 import time
 
 from paraview import servermanager as sm
@@ -33,9 +32,8 @@ import paraview.simple as ps
 from vtkmodules.util.numpy_support import vtk_to_numpy as v2n
 from vtkmodules.vtkIOXML import vtkXMLImageDataWriter, vtkXMLPolyDataWriter, vtkXMLUnstructuredGridWriter
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-import featuremesh as fm  # noqa: E402
-from featuremesh import fem, metrics  # noqa: E402
+import featuremesh as fm
+from featuremesh import fem, metrics
 
 CONNECTIVITY = {"task": "From Task", "off": "Off", "fill": "Fill Holes", "seeded": "Seeded Object"}
 TASK = {"object": "Object", "class": "Class"}

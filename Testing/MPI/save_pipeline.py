@@ -2,11 +2,10 @@
 import os
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
-import featuremesh as fm  # noqa: E402
+import featuremesh as fm
 
 fm.load_plugin()
-import paraview.simple as ps  # noqa: E402
+import paraview.simple as ps
 
 out = sys.argv[1]
 for name in ("nuclei-dsb2018", "liver-ct-totalseg"):

@@ -7,9 +7,8 @@ import subprocess
 import sys
 import tempfile
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Python"))
-import fmtest as ft  # noqa: E402
-from vtkmodules.vtkIOXML import vtkXMLPImageDataReader, vtkXMLPUnstructuredGridReader  # noqa: E402
+import fmtest as ft
+from vtkmodules.vtkIOXML import vtkXMLPImageDataReader, vtkXMLPUnstructuredGridReader
 
 mpirun, pvbatch = shutil.which("mpirun"), shutil.which("pvbatch")
 if not mpirun or not pvbatch:

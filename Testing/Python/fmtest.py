@@ -6,12 +6,11 @@ import shutil
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
-import featuremesh as fm  # noqa: E402
-from featuremesh import dice, fetch, np, seeds, v2n  # noqa: E402,F401
+import featuremesh as fm
+from featuremesh import dice, fetch, np, seeds, v2n  # noqa: F401
 
-from paraview.simple import *  # noqa: E402,F401,F403
-import paraview.simple as ps  # noqa: E402
+from paraview.simple import *  # noqa: F401,F403
+import paraview.simple as ps
 
 fm.load_plugin(ns=globals())
 

@@ -23,9 +23,19 @@ ft.check(ft.fetch(cut, 2).GetPointData().GetArray(N.ElementId) is not None, "the
 root = ft.fm.ROOT
 literal = re.compile(r'GetArray\("(%s)"\)' % "|".join(re.escape(v) for v in N.all_names().values()))
 found = []
-for folder in ("python/featuremesh", "scripts"):
+for folder in ("scripts/featuremesh", "scripts"):
     for name in sorted(os.listdir(os.path.join(root, folder))):
         if name.endswith(".py"):
             with open(os.path.join(root, folder, name)) as f:
                 found += ["%s/%s: %s" % (folder, name, m) for m in literal.findall(f.read())]
 ft.check(not found, "no GetArray(\"...\") literal of a contract name in the package or the scripts %s" % found)
+# One way to the package: the scripts find it beside them, the tests through ctest's PYTHONPATH.
+hacks, needle = [], "sys.path." + "insert"  # not written whole: this file would match
+for folder, _, files in os.walk(root):
+    if os.path.relpath(folder, root).split(os.sep)[0] in ("scripts", "Testing"):
+        for name in files:
+            if name.endswith(".py"):
+                with open(os.path.join(folder, name)) as f:
+                    if needle in f.read():
+                        hacks.append(os.path.relpath(os.path.join(folder, name), root))
+ft.check(not hacks, "no script or test edits sys.path %s" % hacks)
