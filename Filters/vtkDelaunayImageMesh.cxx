@@ -1,7 +1,7 @@
 #include "vtkDelaunayImageMesh.h"
 
 #include "Contract.h"
-#include "DelaunayMesh.h"
+#include "DelaunayImageMesh.h"
 #include "vtkFeatureMeshUtilities.h"
 
 #include "vtkCellArray.h"
@@ -36,12 +36,12 @@ vtkDelaunayImageMesh::vtkDelaunayImageMesh()
 
 void vtkDelaunayImageMesh::SetBackend(int backend)
 {
-  featuremesh::SetClampedParameter(this, this->featuremesh::DelaunayOptions::Backend, backend, TETGEN, CGAL);
+  featuremesh::SetClampedParameter(this, this->featuremesh::DelaunayImageMeshParameters::Backend, backend, TETGEN, CGAL);
 }
 
 int vtkDelaunayImageMesh::GetBackend()
 {
-  return static_cast<int>(this->featuremesh::DelaunayOptions::Backend);
+  return static_cast<int>(this->featuremesh::DelaunayImageMeshParameters::Backend);
 }
 
 int vtkDelaunayImageMesh::FillInputPortInformation(int port, vtkInformation* info)
@@ -141,7 +141,7 @@ bool vtkDelaunayImageMesh::Triangulate(
   // whatever the image's origin, direction or mirror.
   std::vector<std::array<double, 3>> frame(index.size());
   std::transform(index.begin(), index.end(), frame.begin(), [&](const std::array<double, 3>& p) { return geometry.IndexToFrame(p); });
-  const DelaunayOptions o = *this;
+  const DelaunayImageMeshParameters o = *this;
   // TetGen has no progress or abort of its own: it runs on its own thread, owning its input.
   if (geometry.Is2D())
   {
@@ -166,7 +166,7 @@ bool vtkDelaunayImageMesh::Triangulate(
 
 std::string vtkDelaunayImageMesh::ValidateProperties()
 {
-  return featuremesh::ValidateParameters(static_cast<const featuremesh::DelaunayOptions&>(*this), false);
+  return featuremesh::ValidateParameters(static_cast<const featuremesh::DelaunayImageMeshParameters&>(*this), false);
 }
 
 void vtkDelaunayImageMesh::PrintSelf(ostream& os, vtkIndent indent)

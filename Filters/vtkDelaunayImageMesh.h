@@ -16,7 +16,7 @@
 #ifndef vtkDelaunayImageMesh_h
 #define vtkDelaunayImageMesh_h
 
-#include "DelaunayMesh.h" // the parameters, declared once
+#include "DelaunayImageMesh.h" // the parameters, declared once
 #include "FeatureMeshFiltersModule.h"
 #include "vtkFeatureMeshFilter.h" // the shared run and start-up
 #include "vtkUnstructuredGridAlgorithm.h"
@@ -25,10 +25,10 @@
 #include <vector>
 
 // The filter is its Core parameters (TTK's shape): each property's value and default live in
-// featuremesh::DelaunayOptions, which the setters write.
+// featuremesh::DelaunayImageMeshParameters, which the setters write.
 class FEATUREMESHFILTERS_EXPORT vtkDelaunayImageMesh
   : public vtkUnstructuredGridAlgorithm
-  , protected featuremesh::DelaunayOptions
+  , protected featuremesh::DelaunayImageMeshParameters
   , protected featuremesh::FilterBase
 {
 public:

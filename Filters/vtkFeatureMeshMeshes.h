@@ -3,6 +3,7 @@
 #ifndef vtkFeatureMeshMeshes_h
 #define vtkFeatureMeshMeshes_h
 
+#include "ElementQuality.h"
 #include "ElementRasterizer.h"
 #include "ImageGeometry.h"
 #include "Parallel.h"

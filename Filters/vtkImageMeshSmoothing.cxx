@@ -1,7 +1,7 @@
 #include "vtkImageMeshSmoothing.h"
 
 #include "Contract.h"
-#include "MeshSmoothing.h"
+#include "ImageMeshSmoothing.h"
 #include "vtkFeatureMeshUtilities.h"
 
 #include "vtkCellData.h"
@@ -35,7 +35,7 @@ std::vector<std::uint8_t> FixedNodes(vtkUnstructuredGrid* input)
 }
 
 // The field data of a smoothing run: the smallest angle before, the counts of each step and the seconds.
-void AddSmoothingFields(vtkDataObject* output, const featuremesh::MeshSmoothingResult& result, bool is2D, double before,
+void AddSmoothingFields(vtkDataObject* output, const featuremesh::ImageMeshSmoothingResult& result, bool is2D, double before,
   double smoothingSeconds, double statisticsSeconds, double totalSeconds)
 {
   namespace names = featuremesh::names;
@@ -116,7 +116,7 @@ int vtkImageMeshSmoothing::RequestData(
     {
       return this->Fail(error);
     }
-    const MeshSmoothingParameters& par = *this;
+    const ImageMeshSmoothingParameters& par = *this;
     if (par.Iterations == 0)
     {
       output->ShallowCopy(input);
@@ -144,7 +144,7 @@ int vtkImageMeshSmoothing::RequestData(
     this->UpdateProgress(0.05);
 
     double smoothingSeconds = this->Seconds();
-    MeshSmoothingResult result =
+    ImageMeshSmoothingResult result =
       SmoothImageMesh(mesh, FixedNodes(input), floats, par, parallel, AlgorithmProgress(this, 0.05, 0.6));
     if (result.Aborted || !result.Error.empty())
     {
@@ -176,7 +176,7 @@ int vtkImageMeshSmoothing::RequestData(
 
 std::string vtkImageMeshSmoothing::ValidateProperties()
 {
-  return featuremesh::ValidateParameters(static_cast<const featuremesh::MeshSmoothingParameters&>(*this));
+  return featuremesh::ValidateParameters(static_cast<const featuremesh::ImageMeshSmoothingParameters&>(*this));
 }
 
 void vtkImageMeshSmoothing::PrintSelf(ostream& os, vtkIndent indent)

@@ -13,21 +13,21 @@
  * free nodes on the image box slide in their face or edge; box corners stay. The output has the same
  * points (moved) and point arrays, new elements, and stage 2's cell arrays recomputed exactly, with
  * its own voxel owner map; it asks its input for none (docs/CONTRACT.md).
- * See Filters/Core/Smoothing/MeshSmoothing.h.
+ * See Filters/Core/Smoothing/ImageMeshSmoothing.h.
  */
 #ifndef vtkImageMeshSmoothing_h
 #define vtkImageMeshSmoothing_h
 
 #include "FeatureMeshFiltersModule.h"
 #include "vtkFeatureMeshFilter.h" // the shared run and start-up
-#include "MeshSmoothing.h" // the parameters, declared once
+#include "ImageMeshSmoothing.h" // the parameters, declared once
 #include "vtkUnstructuredGridAlgorithm.h"
 
 // The filter is its Core parameters (TTK's shape): each property's value and default live in
-// featuremesh::MeshSmoothingParameters, which the setters write.
+// featuremesh::ImageMeshSmoothingParameters, which the setters write.
 class FEATUREMESHFILTERS_EXPORT vtkImageMeshSmoothing
   : public vtkUnstructuredGridAlgorithm
-  , protected featuremesh::MeshSmoothingParameters
+  , protected featuremesh::ImageMeshSmoothingParameters
   , protected featuremesh::FilterBase
 {
 public:

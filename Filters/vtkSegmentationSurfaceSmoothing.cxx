@@ -1,7 +1,7 @@
 #include "vtkSegmentationSurfaceSmoothing.h"
 
 #include "Contract.h"
-#include "SurfaceSmoothing.h"
+#include "SegmentationSurfaceSmoothing.h"
 #include "vtkFeatureMeshUtilities.h"
 
 #include "vtkCellData.h"
@@ -149,9 +149,9 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
     }
     this->UpdateProgress(0.05);
 
-    const SurfaceSmoothingParameters& par = *this;
+    const SegmentationSurfaceSmoothingParameters& par = *this;
     const ParallelFor parallel = SMPParallelFor();
-    const SurfaceSmoothingResult result =
+    const SegmentationSurfaceSmoothingResult result =
       SmoothSegmentationSurface(mesh, label, par, parallel, AlgorithmProgress(this, 0.05, 0.85));
     if (result.Aborted || !result.Error.empty())
     {
@@ -207,7 +207,7 @@ int vtkSegmentationSurfaceSmoothing::RequestData(
 
 std::string vtkSegmentationSurfaceSmoothing::ValidateProperties()
 {
-  return featuremesh::ValidateParameters(static_cast<const featuremesh::SurfaceSmoothingParameters&>(*this));
+  return featuremesh::ValidateParameters(static_cast<const featuremesh::SegmentationSurfaceSmoothingParameters&>(*this));
 }
 
 void vtkSegmentationSurfaceSmoothing::PrintSelf(ostream& os, vtkIndent indent)

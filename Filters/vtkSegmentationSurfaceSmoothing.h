@@ -11,21 +11,21 @@
  * statistics dropped; its boundary nodes are output 0's points. Point array Shortfall: how far a
  * boundary node stopped from its smoothed position. Nodes on the image box stay
  * on it. With several objects, junction curves (three labels) move along themselves and junction
- * points stay. See Filters/Core/Smoothing/SurfaceSmoothing.h.
+ * points stay. See Filters/Core/Smoothing/SegmentationSurfaceSmoothing.h.
  */
 #ifndef vtkSegmentationSurfaceSmoothing_h
 #define vtkSegmentationSurfaceSmoothing_h
 
 #include "FeatureMeshFiltersModule.h"
 #include "vtkFeatureMeshFilter.h" // the shared run and start-up
-#include "SurfaceSmoothing.h" // the parameters, declared once
+#include "SegmentationSurfaceSmoothing.h" // the parameters, declared once
 #include "vtkPolyDataAlgorithm.h"
 
 // The filter is its Core parameters (TTK's shape): each property's value and default live in
-// featuremesh::SurfaceSmoothingParameters, which the setters write.
+// featuremesh::SegmentationSurfaceSmoothingParameters, which the setters write.
 class FEATUREMESHFILTERS_EXPORT vtkSegmentationSurfaceSmoothing
   : public vtkPolyDataAlgorithm
-  , protected featuremesh::SurfaceSmoothingParameters
+  , protected featuremesh::SegmentationSurfaceSmoothingParameters
   , protected featuremesh::FilterBase
 {
 public:

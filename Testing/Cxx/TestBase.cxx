@@ -1,5 +1,5 @@
 // Unit tests of the Base library (frame, simplex mesh, exact ownership) and the heartbeat.
-#include "DelaunayMesh.h"
+#include "DelaunayImageMesh.h"
 #include "ElementRasterizer.h"
 #include "ImageGeometry.h"
 #include "SimplexMesh.h"
@@ -49,7 +49,7 @@ TEST_P(Tiling, EveryCentreHasExactlyOneOwner)
     if (!used[g.Index(i, j, k)]++)
       pts.push_back({ { double(i), double(j), double(k) } });
   }
-  DelaunayOptions o;
+  DelaunayImageMeshParameters o;
   o.Backend = mode == 2 ? DelaunayBackend::CGAL : DelaunayBackend::TetGen;
   const DelaunayResult mesh = mode == 0 ? Triangulate2D(pts) : Tetrahedralize(pts, o);
   ASSERT_TRUE(mesh.Error.empty()) << mesh.Error;
@@ -286,7 +286,7 @@ TEST(SimplexMesh, LabelBoundaryIsClosedAndOutward)
     for (int j = 0; j < 5; j += 2)
       for (int i = 0; i < 5; i += 2)
         pts.push_back({ { double(i) + (i == 2 && j == 2 ? 0.5 : 0.0), double(j), double(k) } });
-  const DelaunayResult d = Tetrahedralize(pts, DelaunayOptions());
+  const DelaunayResult d = Tetrahedralize(pts, DelaunayImageMeshParameters());
   ASSERT_TRUE(d.Error.empty());
   const SimplexMesh mesh(g, d.Points, d.Cells, 4);
   const std::vector<std::array<double, 3>> frame = mesh.FramePoints();

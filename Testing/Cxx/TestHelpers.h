@@ -1,7 +1,8 @@
 // What the Core unit tests share: one test binary (FeatureMeshCoreTests), a file per Core library.
 #pragma once
 
-#include "DelaunayMesh.h"
+#include "DelaunayImageMesh.h"
+#include "ElementQuality.h"
 #include "ImageGeometry.h"
 #include "Parallel.h"
 #include "SimplexMesh.h"
@@ -42,7 +43,7 @@ inline bool CGALMeshOfNodes(const ImageGeometry& g, std::vector<std::array<doubl
 {
   std::sort(pts.begin(), pts.end());
   pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
-  DelaunayOptions o;
+  DelaunayImageMeshParameters o;
   o.Backend = DelaunayBackend::CGAL;
   const DelaunayResult d = g.Is2D() ? Triangulate2D(pts) : Tetrahedralize(pts, o);
   EXPECT_TRUE(d.Error.empty()) << d.Error;

@@ -1,5 +1,5 @@
 // Unit tests of the Meshing library (Delaunay meshes and their refinement, stage 2's nodes).
-#include "DelaunayMesh.h"
+#include "DelaunayImageMesh.h"
 #include "ElementRasterizer.h"
 #include "ExactPredicates.h"
 #include "TestHelpers.h"
@@ -38,7 +38,7 @@ TEST(Delaunay, ImageMeshNodesAreCheckedAndTheBoxCornersAdded)
   EXPECT_NE(ImageMeshNodes(g, twice).find("duplicate"), std::string::npos);
   std::vector<std::array<double, 3>> line = { { { 0.0, 0.0, 0.0 } }, { { 2.0, 1.0, 0.0 } }, { { 4.0, 2.0, 0.0 } } };
   EXPECT_NE(ImageMeshNodes(g, line).find("collinear"), std::string::npos);
-  DelaunayOptions o;
+  DelaunayImageMeshParameters o;
   o.QualityRefinement = true;
   o.MinDihedralAngle = 25.0;
   EXPECT_FALSE(ValidateParameters(o, false).empty());
@@ -51,8 +51,8 @@ TEST(Delaunay, DegenerateInputIsAnError)
   EXPECT_FALSE(Triangulate2D(line).Error.empty());
   std::vector<std::array<double, 3>> plane = { { { 0, 0, 0 } }, { { 1, 0, 0 } }, { { 0, 1, 0 } }, { { 1, 1, 0 } },
     { { 2, 3, 0 } } };
-  EXPECT_FALSE(Tetrahedralize(plane, DelaunayOptions()).Error.empty());
-  DelaunayOptions cgal;
+  EXPECT_FALSE(Tetrahedralize(plane, DelaunayImageMeshParameters()).Error.empty());
+  DelaunayImageMeshParameters cgal;
   cgal.Backend = DelaunayBackend::CGAL;
   EXPECT_FALSE(Tetrahedralize(plane, cgal).Error.empty());
   EXPECT_EQ(CountDuplicates({ { { 0, 0, 0 } }, { { 1, 0, 0 } }, { { 0, 0, 0 } } }), 1);
@@ -81,7 +81,7 @@ TEST(Delaunay, QualityRefinementRaisesTheMinimumDihedralAngle)
   std::vector<std::array<double, 3>> frame;
   for (const auto& p : index)
     frame.push_back(g.IndexToFrame(p));
-  DelaunayOptions plain, refined;
+  DelaunayImageMeshParameters plain, refined;
   refined.QualityRefinement = true;
   const DelaunayResult a = Tetrahedralize(frame, plain), b = Tetrahedralize(frame, refined);
   ASSERT_TRUE(a.Error.empty()) << a.Error;

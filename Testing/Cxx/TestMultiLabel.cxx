@@ -1,11 +1,11 @@
 // Multi-label cuts: alpha-expansion, labelled seeds, several channels (MultiLabelCut.h).
 #include "AlphaExpansion.h"
-#include "DelaunayMesh.h"
+#include "DelaunayImageMesh.h"
 #include "ElementRasterizer.h"
 #include "MultiLabelCut.h"
 #include "SimplexMesh.h"
 #include "SeedGeodesics.h"
-#include "SurfaceSmoothing.h"
+#include "SegmentationSurfaceSmoothing.h"
 
 #include <gtest/gtest.h>
 
@@ -506,7 +506,7 @@ TEST(MultiLabelSurface, ATJunctionKeepsItsPointAndEveryInterfaceStaysClosed)
     label[e] = cx + wobble < 20 ? 1 : (cy + wobble > 20 ? 2 : 0);
   }
   const std::vector<int> before = StarLabelCount(mesh, label);
-  const SurfaceSmoothingResult r = SmoothSegmentationSurface(mesh, label, SurfaceSmoothingParameters(), SerialFor());
+  const SegmentationSurfaceSmoothingResult r = SmoothSegmentationSurface(mesh, label, SegmentationSurfaceSmoothingParameters(), SerialFor());
   ASSERT_TRUE(r.Error.empty()) << r.Error;
   std::int64_t points = 0, moved = 0;
   for (std::int64_t v = 0; v < mesh.NumberOfPoints(); ++v)
@@ -561,7 +561,7 @@ TEST(MultiLabelSurface, AJunctionCurveMovesAlongItselfIn3D)
         const bool box = i == 0 || j == 0 || k == 0 || i == 24 || j == 24 || k == 24;
         pts.push_back({ { i + (box ? 0.0 : jitter(rng)), j + (box ? 0.0 : jitter(rng)), k + (box ? 0.0 : jitter(rng)) } });
       }
-  DelaunayOptions o;
+  DelaunayImageMeshParameters o;
   o.Backend = DelaunayBackend::CGAL;
   const DelaunayResult d = Tetrahedralize(pts, o);
   ASSERT_TRUE(d.Error.empty()) << d.Error;
@@ -577,7 +577,7 @@ TEST(MultiLabelSurface, AJunctionCurveMovesAlongItselfIn3D)
     label[e] = std::hypot(c[0] - 12, c[1] - 12, c[2] - 12) > 8 ? 0 : (c[2] < 12 ? 1 : 2);
   }
   const std::vector<int> before = StarLabelCount(mesh, label);
-  const SurfaceSmoothingResult r = SmoothSegmentationSurface(mesh, label, SurfaceSmoothingParameters(), SerialFor());
+  const SegmentationSurfaceSmoothingResult r = SmoothSegmentationSurface(mesh, label, SegmentationSurfaceSmoothingParameters(), SerialFor());
   ASSERT_TRUE(r.Error.empty()) << r.Error;
   std::int64_t curve = 0, curveMoved = 0;
   for (std::int64_t v = 0; v < mesh.NumberOfPoints(); ++v)

@@ -6,7 +6,7 @@
 #include "SeedGeodesics.h"
 #include "SuperVoxelCut.h"
 #include "ElementRasterizer.h"
-#include "DelaunayMesh.h"
+#include "DelaunayImageMesh.h"
 #include "TestHelpers.h"
 
 #include <gtest/gtest.h>

@@ -1,8 +1,8 @@
 // Unit tests of the Smoothing library (stage 3's image mesh smoothing, stage 6's surface smoothing).
-#include "MeshSmoothing.h"
-#include "SurfaceSmoothing.h"
+#include "ImageMeshSmoothing.h"
+#include "SegmentationSurfaceSmoothing.h"
 #include "ElementRasterizer.h"
-#include "DelaunayMesh.h"
+#include "DelaunayImageMesh.h"
 #include "TestHelpers.h"
 
 #include <gtest/gtest.h>
@@ -62,7 +62,7 @@ SimplexMesh JitteredMesh(const ImageGeometry& g, std::vector<std::uint8_t>& fixe
   {
     pts.push_back({ { double(q[0]), double(q[1]), double(q[2]) } });
   }
-  DelaunayOptions o;
+  DelaunayImageMeshParameters o;
   o.Backend = DelaunayBackend::CGAL;
   const DelaunayResult d = dim == 2 ? Triangulate2D(pts) : Tetrahedralize(pts, o);
   EXPECT_TRUE(d.Error.empty()) << d.Error;
@@ -82,7 +82,7 @@ double MinimumAngle(const SimplexMesh& mesh)
 }
 } // namespace
 
-TEST(MeshSmoothing, TargetsOfOneFreeNodeMatchTheFormulas)
+TEST(ImageMeshSmoothing, TargetsOfOneFreeNodeMatchTheFormulas)
 {
   const SimplexMesh mesh = FreeNodeInSquare();
   const std::int64_t star[4] = { 0, 1, 2, 3 };
@@ -109,7 +109,7 @@ TEST(MeshSmoothing, TargetsOfOneFreeNodeMatchTheFormulas)
   EXPECT_NEAR(t[1], 86.0 / 22.0, 1e-12);
 }
 
-TEST(MeshSmoothing, DensityGrowsWithTheGradientAndIsOneWhenFlat)
+TEST(ImageMeshSmoothing, DensityGrowsWithTheGradientAndIsOneWhenFlat)
 {
   const SimplexMesh mesh = FreeNodeInSquare();
   std::vector<float> gradient(100, 0.f);
@@ -124,7 +124,7 @@ TEST(MeshSmoothing, DensityGrowsWithTheGradientAndIsOneWhenFlat)
   EXPECT_NEAR(ElementDensity(mesh, mesh.Points(), 1, gradient.data(), 1.0, 1.0), 1.0 + 5.0, 1e-12);
 }
 
-TEST(MeshSmoothing, FixedNodesStayBoxNodesSlideAndTheMeshStaysValid)
+TEST(ImageMeshSmoothing, FixedNodesStayBoxNodesSlideAndTheMeshStaysValid)
 {
   for (int dim : { 2, 3 })
   {
@@ -137,8 +137,8 @@ TEST(MeshSmoothing, FixedNodesStayBoxNodesSlideAndTheMeshStaysValid)
       for (int j = 0; j < g.Dims[1]; ++j)
         for (int i = 0; i < g.Dims[0]; ++i)
           image[g.Index(i, j, k)] = std::hypot(i - 20.0, j - 17.0) < 9.0 ? 200.f : 20.f;
-    MeshSmoothingParameters p;
-    const MeshSmoothingResult r = SmoothImageMesh(mesh, fixed, image.data(), p, SerialFor());
+    ImageMeshSmoothingParameters p;
+    const ImageMeshSmoothingResult r = SmoothImageMesh(mesh, fixed, image.data(), p, SerialFor());
     ASSERT_TRUE(r.Error.empty()) << r.Error;
     ASSERT_FALSE(r.Aborted);
     EXPECT_EQ(r.IterationsRun, p.Iterations);
@@ -192,13 +192,13 @@ TEST(MeshSmoothing, FixedNodesStayBoxNodesSlideAndTheMeshStaysValid)
     EXPECT_LE(snapped, r.SnappedNodes);
     EXPECT_EQ(r.SnappedNodes > 0, dim == 3);
     // The same result split into any chunks (the threads' stand-in), and again.
-    const MeshSmoothingResult again = SmoothImageMesh(mesh, fixed, image.data(), p, Chunked);
+    const ImageMeshSmoothingResult again = SmoothImageMesh(mesh, fixed, image.data(), p, Chunked);
     EXPECT_EQ(again.Mesh.Points(), out.Points());
     EXPECT_EQ(again.Mesh.Cells(), out.Cells());
   }
 }
 
-TEST(MeshSmoothing, RefinementReachesTheAngleBounds)
+TEST(ImageMeshSmoothing, RefinementReachesTheAngleBounds)
 {
   for (int dim : { 2, 3 })
   {
@@ -208,9 +208,9 @@ TEST(MeshSmoothing, RefinementReachesTheAngleBounds)
     const SimplexMesh mesh = JitteredMesh(g, fixed, 5);
     std::fill(fixed.begin(), fixed.end(), 1); // nothing moves: refinement alone
     const std::vector<float> image(g.Size(), 1.f);
-    MeshSmoothingParameters p;
+    ImageMeshSmoothingParameters p;
     p.SliverRemoval = false;
-    const MeshSmoothingResult r = SmoothImageMesh(mesh, fixed, image.data(), p, SerialFor());
+    const ImageMeshSmoothingResult r = SmoothImageMesh(mesh, fixed, image.data(), p, SerialFor());
     ASSERT_TRUE(r.Error.empty()) << r.Error;
     EXPECT_EQ(r.Moves, 0);
     EXPECT_GT(r.AddedNodes, 0);
@@ -225,19 +225,19 @@ TEST(MeshSmoothing, RefinementReachesTheAngleBounds)
   }
 }
 
-TEST(MeshSmoothing, BadParametersAreNamed)
+TEST(ImageMeshSmoothing, BadParametersAreNamed)
 {
-  MeshSmoothingParameters p;
+  ImageMeshSmoothingParameters p;
   EXPECT_TRUE(ValidateParameters(p).empty());
   p.Iterations = -1;
   EXPECT_NE(ValidateParameters(p).find("iterations"), std::string::npos);
-  p = MeshSmoothingParameters();
+  p = ImageMeshSmoothingParameters();
   p.MinAngle = 25;
   EXPECT_NE(ValidateParameters(p).find("minimum angle"), std::string::npos);
-  p = MeshSmoothingParameters();
+  p = ImageMeshSmoothingParameters();
   p.Sigma = 0;
   EXPECT_NE(ValidateParameters(p).find("sigma"), std::string::npos);
-  p = MeshSmoothingParameters();
+  p = ImageMeshSmoothingParameters();
   p.FixedNodeSlack = -1;
   EXPECT_NE(ValidateParameters(p).find("slack"), std::string::npos);
 }
@@ -318,7 +318,7 @@ double MeanDistanceToSphere(const SimplexMesh& mesh, const std::vector<std::arra
 }
 } // namespace
 
-TEST(SurfaceSmoothing, StaircaseBallComesCloserToTheSphereAndTheMeshStaysValid)
+TEST(SegmentationSurfaceSmoothing, StaircaseBallComesCloserToTheSphereAndTheMeshStaysValid)
 {
   for (const int dim : { 2, 3 })
   {
@@ -333,10 +333,10 @@ TEST(SurfaceSmoothing, StaircaseBallComesCloserToTheSphereAndTheMeshStaysValid)
     for (const auto method : { SurfaceSmoothingMethod::Laplacian, SurfaceSmoothingMethod::Taubin })
     {
       SCOPED_TRACE(std::to_string(dim) + "D, method " + std::to_string(int(method)));
-      SurfaceSmoothingParameters p;
+      SegmentationSurfaceSmoothingParameters p;
       p.Method = method;
       p.Iterations = method == SurfaceSmoothingMethod::Taubin ? 10 : 3;
-      const SurfaceSmoothingResult r = SmoothSegmentationSurface(s.Mesh, s.Label, p, SerialFor());
+      const SegmentationSurfaceSmoothingResult r = SmoothSegmentationSurface(s.Mesh, s.Label, p, SerialFor());
       ASSERT_TRUE(r.Error.empty()) << r.Error;
       EXPECT_EQ(r.Faces, faces);
       EXPECT_GT(r.InterfaceFaces, 0);
@@ -348,9 +348,9 @@ TEST(SurfaceSmoothing, StaircaseBallComesCloserToTheSphereAndTheMeshStaysValid)
       // The mesh follows most of the smoothing: nodes whose star would flatten stop short, by less than
       // a fifth of the smoothing's own displacement on average (the positions without the volume mesh).
       EXPECT_LT(r.ShortNodes, r.BoundaryNodes / 4);
-      SurfaceSmoothingParameters alone = p;
+      SegmentationSurfaceSmoothingParameters alone = p;
       alone.VolumeMesh = false;
-      const SurfaceSmoothingResult targets = SmoothSegmentationSurface(s.Mesh, s.Label, alone, SerialFor());
+      const SegmentationSurfaceSmoothingResult targets = SmoothSegmentationSurface(s.Mesh, s.Label, alone, SerialFor());
       double shortfall = 0, displacement = 0;
       for (const std::int64_t v : std::set<std::int64_t>(faces.begin(), faces.end()))
       {
@@ -399,18 +399,18 @@ TEST(SurfaceSmoothing, StaircaseBallComesCloserToTheSphereAndTheMeshStaysValid)
   }
 }
 
-TEST(SurfaceSmoothing, BadInputIsNamed)
+TEST(SegmentationSurfaceSmoothing, BadInputIsNamed)
 {
   const Staircase s = StaircaseBall(2, 8, { { 4, 4, 0 } }, 3.0);
-  SurfaceSmoothingParameters p;
+  SegmentationSurfaceSmoothingParameters p;
   p.Relaxation = 0;
   EXPECT_FALSE(SmoothSegmentationSurface(s.Mesh, s.Label, p, SerialFor()).Error.empty());
   std::vector<std::uint8_t> bad = s.Label; // labels 2..255 are further objects (TestMultiLabel.cxx)
   bad.pop_back();
-  EXPECT_FALSE(SmoothSegmentationSurface(s.Mesh, bad, SurfaceSmoothingParameters(), SerialFor()).Error.empty());
+  EXPECT_FALSE(SmoothSegmentationSurface(s.Mesh, bad, SegmentationSurfaceSmoothingParameters(), SerialFor()).Error.empty());
   // No object: nothing moves.
-  const SurfaceSmoothingResult none =
-    SmoothSegmentationSurface(s.Mesh, std::vector<std::uint8_t>(s.Label.size(), 0), SurfaceSmoothingParameters(), SerialFor());
+  const SegmentationSurfaceSmoothingResult none =
+    SmoothSegmentationSurface(s.Mesh, std::vector<std::uint8_t>(s.Label.size(), 0), SegmentationSurfaceSmoothingParameters(), SerialFor());
   EXPECT_TRUE(none.Error.empty());
   EXPECT_TRUE(none.Faces.empty());
   EXPECT_EQ(none.Points, s.Mesh.Points());

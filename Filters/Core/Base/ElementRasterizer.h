@@ -1,5 +1,5 @@
 // Exact assignment of voxel centres to the triangles / tetrahedra of a mesh that tiles the image box,
-// and the per-element measures built on it (statistics, quality).
+// and the per-element measures built on it (statistics; quality is ElementQuality.h).
 //
 // Tie rule: a centre p on a shared edge/face belongs to the element that contains
 // p + e(c - p) + e^2 t, e -> 0, with c the box centre and t a lexicographic direction. The first
@@ -139,14 +139,6 @@ private:
 std::vector<std::int32_t> VoxelOwners(const ElementRasterizer& raster, const ParallelFor& parallel,
   const ProgressFunction& progress = NoProgress());
 
-// Quality in frame (world) units: minimum angle (triangles) or minimum dihedral angle (tetrahedra)
-// in degrees, and the radius ratio normalised to 1 for the equilateral element (2r/R, 3r/R).
-void ElementQuality(const SimplexMesh& mesh, std::vector<double>& minAngle, std::vector<double>& radiusRatio,
-  const ParallelFor& parallel);
-
-// Minimum angle (triangle) or minimum dihedral angle (tetrahedron) in degrees of the element with
-// vertices v[0..vpc) (any orientation; 0 for a flat one).
-double SimplexMinAngle(const std::array<double, 3>* const* v, int verticesPerCell);
 
 // Trilinear (bilinear in 2D) interpolation of voxel values at a continuous index (T any arithmetic type).
 template <typename T>

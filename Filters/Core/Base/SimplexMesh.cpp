@@ -1,4 +1,5 @@
 #include "SimplexMesh.h"
+#include "Vector3.h"
 
 #include <algorithm>
 #include <cmath>
@@ -136,22 +137,17 @@ FaceAdjacency BuildFaces(
 }
 } // namespace
 
+double SimplexMeasure(const std::array<double, 3>* const* v, int vpc)
+{
+  using namespace vector3;
+  const V3 b = Sub(*v[1], *v[0]), d = Sub(*v[2], *v[0]);
+  return vpc == 3 ? 0.5 * (b[0] * d[1] - b[1] * d[0]) : Dot(b, Cross(d, Sub(*v[3], *v[0]))) / 6.0;
+}
+
 double ElementMeasure(const std::vector<std::array<double, 3>>& P, const std::int64_t* c, int vpc)
 {
-  const auto& a = P[c[0]];
-  const auto& b = P[c[1]];
-  const auto& d = P[c[2]];
-  if (vpc == 3)
-  {
-    return 0.5 * ((b[0] - a[0]) * (d[1] - a[1]) - (b[1] - a[1]) * (d[0] - a[0]));
-  }
-  const auto& e = P[c[3]];
-  const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
-  const double v[3] = { d[0] - a[0], d[1] - a[1], d[2] - a[2] };
-  const double w[3] = { e[0] - a[0], e[1] - a[1], e[2] - a[2] };
-  return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-           u[2] * (v[0] * w[1] - v[1] * w[0])) /
-    6.0;
+  const std::array<double, 3>* v[4] = { &P[c[0]], &P[c[1]], &P[c[2]], vpc == 4 ? &P[c[3]] : nullptr };
+  return SimplexMeasure(v, vpc);
 }
 
 SimplexMesh::SimplexMesh(const ImageGeometry& geometry, std::vector<std::array<double, 3>> indexPoints,
@@ -454,5 +450,28 @@ std::vector<std::int64_t> LabelBoundaryFaces(const SimplexMesh& mesh, const Face
     }
   }
   return OrientedBoundary(mesh, inner, hull, interfaceFaces);
+}
+
+std::vector<std::uint8_t> FreeAxes(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, bool fixedMayMove)
+{
+  const ImageGeometry& g = mesh.Geometry();
+  const int dimension = g.Dimension();
+  const auto& P = mesh.Points();
+  std::vector<std::uint8_t> free(P.size(), 0);
+  for (size_t i = 0; i < P.size(); ++i)
+  {
+    if (i < fixed.size() && fixed[i] && !fixedMayMove)
+    {
+      continue;
+    }
+    for (int a = 0; a < dimension; ++a)
+    {
+      if (P[i][a] != 0.0 && P[i][a] != g.Dims[a] - 1.0)
+      {
+        free[i] |= static_cast<std::uint8_t>(1 << a);
+      }
+    }
+  }
+  return free;
 }
 } // namespace featuremesh

@@ -86,7 +86,10 @@ private:
   std::shared_ptr<Cache> Cached = std::make_shared<Cache>();
 };
 
-// Signed area (triangles, xy) or volume (tetrahedra) of an element of `points`.
+// Signed area (triangles, xy) or volume (tetrahedra) of the simplex with vertices v[0..vpc): the
+// one formula of the project (orientation, ODT weights, a label's measure).
+double SimplexMeasure(const std::array<double, 3>* const* v, int verticesPerCell);
+// The same of an element of `points`.
 double ElementMeasure(const std::vector<std::array<double, 3>>& points, const std::int64_t* cell, int verticesPerCell);
 
 // Vertex ids of local face f of an element (the face opposite local vertex f), ordered so that the
@@ -104,4 +107,8 @@ std::vector<std::int64_t> LabelBoundaryFaces(
 // The same from the mesh's face adjacency (Faces()), for callers that hold it: no hashing.
 std::vector<std::int64_t> LabelBoundaryFaces(const SimplexMesh& mesh, const FaceAdjacency& adjacency,
   const std::vector<std::uint8_t>& label, std::int64_t* interfaceFaces = nullptr);
+
+// Per-node freedom in the image box (stages 3 and 6): which index axes a node may move along (bit a = axis a): none for fixed nodes
+// (unless fixedMayMove) and box corners, the axes of its face or edge for a node on the box.
+std::vector<std::uint8_t> FreeAxes(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, bool fixedMayMove = false);
 } // namespace featuremesh

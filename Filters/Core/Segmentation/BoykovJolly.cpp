@@ -1,5 +1,6 @@
 #include "BoykovJolly.h"
 #include "Memory.h"
+#include "Percentile.h"
 
 #include <maxflow.h>
 
@@ -31,26 +32,6 @@ std::string UnusableIntensities(std::int64_t count)
   return std::to_string(count) + " intensities are NaN, infinite or beyond +-1e150; replace or rescale them (e.g. with a Calculator) first.";
 }
 
-// Percentile of at most ~1 M evenly strided values: exact enough for a histogram range, and a
-// 9 M-voxel volume is not copied and partially sorted twice.
-template <typename T>
-double Percentile(const T* data, std::int64_t n, double q)
-{
-  if (n <= 0)
-  {
-    return 0.0;
-  }
-  const std::int64_t stride = std::max<std::int64_t>(1, n / 1000000);
-  std::vector<double> v;
-  v.reserve(static_cast<size_t>(n / stride + 1));
-  for (std::int64_t i = 0; i < n; i += stride)
-  {
-    v.push_back(static_cast<double>(data[i]));
-  }
-  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q / 100.0 * static_cast<double>(v.size() - 1) + 0.5));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
 using Clock = std::chrono::steady_clock;
 } // namespace
 
@@ -387,8 +368,8 @@ bool GroupVoxelValues(const std::int32_t* owner, const T* values, std::int64_t v
   grouped.ValueType = VoxelTypeIndex<T>();
   grouped.Voxels = voxels;
   grouped.Nodes = nodes;
-  grouped.Low = Percentile(values, voxels, 0.5);
-  grouped.High = Percentile(values, voxels, 99.5);
+  grouped.Low = StridedPercentile(values, voxels, 0.5);
+  grouped.High = StridedPercentile(values, voxels, 99.5);
   grouped.Keep = std::move(keep);
   return progress(1.0);
 }
@@ -748,8 +729,8 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     return r;
   }
   const NodeVoxelValues* exact = pr.NodeVoxels;
-  double low = exact ? exact->Low : Percentile(pr.Value.data(), n, 0.5);
-  double high = exact ? exact->High : Percentile(pr.Value.data(), n, 99.5);
+  double low = exact ? exact->Low : StridedPercentile(pr.Value.data(), n, 0.5);
+  double high = exact ? exact->High : StridedPercentile(pr.Value.data(), n, 99.5);
   for (double v : pr.ObjectSamples)
   {
     low = std::min(low, v);

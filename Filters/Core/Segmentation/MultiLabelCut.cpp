@@ -1,4 +1,5 @@
 #include "MultiLabelCut.h"
+#include "Percentile.h"
 #include "SeedGeodesics.h"
 
 #include <algorithm>
@@ -14,28 +15,12 @@ namespace
 using Clock = std::chrono::steady_clock;
 double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// Percentile of channel c over at most ~1 M evenly strided voxels.
-template <typename T>
-double ChannelPercentile(const T* values, int channels, int c, std::int64_t voxels, double q)
-{
-  const std::int64_t stride = std::max<std::int64_t>(1, voxels / 1000000);
-  std::vector<double> v;
-  v.reserve(static_cast<std::size_t>(voxels / stride + 1));
-  for (std::int64_t i = 0; i < voxels; i += stride)
-  {
-    v.push_back(static_cast<double>(values[i * channels + c]));
-  }
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q / 100.0 * static_cast<double>(v.size() - 1) + 0.5));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
 // Channel c's histogram range: its 0.5 and 99.5 percentiles, one unit wide when they meet.
 template <typename T>
 std::array<double, 2> ChannelRange(const T* values, int channels, int c, std::int64_t voxels)
 {
-  const double low = ChannelPercentile(values, channels, c, voxels, 0.5);
-  const double high = ChannelPercentile(values, channels, c, voxels, 99.5);
+  const double low = StridedPercentile(values, voxels, 0.5, channels, c);
+  const double high = StridedPercentile(values, voxels, 99.5, channels, c);
   return { { low, high > low ? high : low + 1.0 } };
 }
 

@@ -1,4 +1,4 @@
-#include "DelaunayMesh.h"
+#include "DelaunayImageMesh.h"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Delaunay_mesh_criteria_2.h>
@@ -119,7 +119,7 @@ bool BoxCorners(const std::vector<std::array<double, 3>>& points, std::array<int
   return true;
 }
 
-DelaunayResult TetrahedralizeTetGen(const std::vector<std::array<double, 3>>& points, const DelaunayOptions& o)
+DelaunayResult TetrahedralizeTetGen(const std::vector<std::array<double, 3>>& points, const DelaunayImageMeshParameters& o)
 {
   DelaunayResult r;
   tetgenio in, out;
@@ -419,7 +419,7 @@ DelaunayResult RefineQuality2D(const std::vector<std::array<double, 3>>& points,
   return r;
 }
 
-DelaunayResult Tetrahedralize(const std::vector<std::array<double, 3>>& points, const DelaunayOptions& o)
+DelaunayResult Tetrahedralize(const std::vector<std::array<double, 3>>& points, const DelaunayImageMeshParameters& o)
 {
   try
   {
@@ -442,7 +442,7 @@ DelaunayResult Tetrahedralize(const std::vector<std::array<double, 3>>& points, 
   }
 }
 
-std::string ValidateParameters(const DelaunayOptions& o, bool planar)
+std::string ValidateParameters(const DelaunayImageMeshParameters& o, bool planar)
 {
   // TetGen's refinement need not terminate beyond these bounds (its guarantee holds for a ratio of 2
   // and no angle bound): the liver's nodes never returned with a ratio of 1.0 or an angle of 25.

@@ -17,7 +17,7 @@ enum class DelaunayBackend
   CGAL = 1
 };
 
-struct DelaunayOptions
+struct DelaunayImageMeshParameters
 {
   DelaunayBackend Backend = DelaunayBackend::TetGen;
   // TetGen quality refinement (adds nodes): radius-edge bound and minimum dihedral angle (deg).
@@ -42,7 +42,7 @@ struct DelaunayResult
 // Points are (x, y[, z]); 2D uses x and y only. Positive orientation: counter-clockwise triangles,
 // tetrahedra with det[b-a, c-a, d-a] > 0.
 DelaunayResult Triangulate2D(const std::vector<std::array<double, 3>>& points);
-DelaunayResult Tetrahedralize(const std::vector<std::array<double, 3>>& points, const DelaunayOptions& options);
+DelaunayResult Tetrahedralize(const std::vector<std::array<double, 3>>& points, const DelaunayImageMeshParameters& options);
 
 // Delaunay refinement of a mesh of the points over their bounding box (the box's faces are the
 // domain boundary; every point is kept, at its index): 2D CGAL Delaunay_mesher_2 to a minimum angle
@@ -62,7 +62,7 @@ constexpr std::int64_t MaximumImageMeshNodes = 20000000;
 
 // Empty when `options` can mesh an image (`planar`: 2D), else a sentence: 3D quality refinement
 // needs a radius-edge ratio of at least 1.2 and a dihedral bound in [0, 18] degrees.
-std::string ValidateParameters(const DelaunayOptions& options, bool planar);
+std::string ValidateParameters(const DelaunayImageMeshParameters& options, bool planar);
 
 // Stage 2's nodes: `points` (world coordinates) into the image's index space, checked (enough of
 // them, inside the image, on its plane in 2D, at most MaximumImageMeshNodes, no duplicates,

@@ -33,7 +33,7 @@ enum class SmoothingMethod
   ODT = 1  // thesis eq. 12: density-weighted mean of the star's circumcentres
 };
 
-struct MeshSmoothingParameters
+struct ImageMeshSmoothingParameters
 {
   SmoothingMethod Method = SmoothingMethod::ODT;
   // Three sweeps: the thesis's five give the same angles after refinement, an oracle Dice within
@@ -62,11 +62,7 @@ struct MeshSmoothingParameters
 };
 
 // Empty when the parameters are usable, else a sentence naming the bad one.
-std::string ValidateParameters(const MeshSmoothingParameters& parameters);
-
-// Per-node freedom: which index axes a node may move along (bit a = axis a): none for fixed nodes
-// (unless fixedMayMove) and box corners, the axes of its face or edge for a node on the box.
-std::vector<std::uint8_t> FreeAxes(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, bool fixedMayMove = false);
+std::string ValidateParameters(const ImageMeshSmoothingParameters& parameters);
 
 // Density rho of an element of `mesh` (see above) with its vertices at `points` (index space), from
 // a gradient-magnitude image on the mesh's grid; `meanGradient` is mean(g) over the image (0: rho = 1).
@@ -79,7 +75,7 @@ double ElementDensity(const SimplexMesh& mesh, const std::vector<std::array<doub
 std::array<double, 3> SmoothingTarget(const SimplexMesh& mesh, const std::vector<std::array<double, 3>>& points,
   const std::int64_t* star, std::int64_t starSize, const double* density, SmoothingMethod method);
 
-struct MeshSmoothingResult
+struct ImageMeshSmoothingResult
 {
   SimplexMesh Mesh;
   int IterationsRun = 0;
@@ -96,7 +92,7 @@ struct MeshSmoothingResult
 
 // Smooths `mesh` (index space, elements positively oriented, tiling the image box) on the image
 // `values` (one per voxel). `fixed` has one flag per mesh point.
-MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, const float* values,
-  const MeshSmoothingParameters& parameters, const ParallelFor& parallel,
+ImageMeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, const float* values,
+  const ImageMeshSmoothingParameters& parameters, const ParallelFor& parallel,
   const ProgressFunction& progress = NoProgress());
 } // namespace featuremesh

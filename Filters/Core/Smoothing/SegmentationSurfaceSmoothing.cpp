@@ -1,6 +1,4 @@
-#include "SurfaceSmoothing.h"
-
-#include "MeshSmoothing.h"
+#include "SegmentationSurfaceSmoothing.h"
 #include "Vector3.h"
 
 #include <algorithm>
@@ -290,9 +288,7 @@ double LabelledMeasure(const SimplexMesh& mesh, const std::vector<V3>& frame, co
   {
     if (label[e])
     {
-      const std::int64_t* c = mesh.Cell(e);
-      const V3 a = Sub(frame[c[1]], frame[c[0]]), d = Sub(frame[c[2]], frame[c[0]]);
-      sum += vpc == 3 ? std::fabs(a[0] * d[1] - a[1] * d[0]) / 2.0 : std::fabs(Dot(a, Cross(d, Sub(frame[c[3]], frame[c[0]])))) / 6.0;
+      sum += std::fabs(ElementMeasure(frame, mesh.Cell(e), vpc));
     }
   }
   return sum;
@@ -432,7 +428,7 @@ V3 Lerp(const V3& a, const V3& b, double t)
 }
 } // namespace
 
-std::string ValidateParameters(const SurfaceSmoothingParameters& p)
+std::string ValidateParameters(const SegmentationSurfaceSmoothingParameters& p)
 {
   if (p.Method != SurfaceSmoothingMethod::Laplacian && p.Method != SurfaceSmoothingMethod::Taubin)
   {
@@ -461,10 +457,10 @@ std::string ValidateParameters(const SurfaceSmoothingParameters& p)
   return std::string();
 }
 
-SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const std::vector<std::uint8_t>& label,
-  const SurfaceSmoothingParameters& p, const ParallelFor& parallel, const ProgressFunction& progress)
+SegmentationSurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const std::vector<std::uint8_t>& label,
+  const SegmentationSurfaceSmoothingParameters& p, const ParallelFor& parallel, const ProgressFunction& progress)
 {
-  SurfaceSmoothingResult r;
+  SegmentationSurfaceSmoothingResult r;
   r.Error = ValidateParameters(p);
   const std::int64_t nElements = mesh.NumberOfElements();
   if (r.Error.empty() && static_cast<std::int64_t>(label.size()) != nElements)

@@ -1,7 +1,7 @@
-#include "MeshSmoothing.h"
+#include "ImageMeshSmoothing.h"
 #include "Memory.h"
 
-#include "DelaunayMesh.h"
+#include "DelaunayImageMesh.h"
 #include "ElementRasterizer.h"
 #include "ExactPredicates.h"
 #include "ImageFilters.h"
@@ -60,12 +60,7 @@ bool Circumcentre(const V3* const* v, int vpc, V3& centre)
 
 double Measure(const V3* const* v, int vpc)
 {
-  if (vpc == 3)
-  {
-    const V3 b = Sub(*v[1], *v[0]), c = Sub(*v[2], *v[0]);
-    return 0.5 * std::fabs(b[0] * c[1] - b[1] * c[0]);
-  }
-  return std::fabs(Dot(Sub(*v[1], *v[0]), Cross(Sub(*v[2], *v[0]), Sub(*v[3], *v[0])))) / 6.0;
+  return std::fabs(SimplexMeasure(v, vpc));
 }
 
 // A cheap stand-in for the smallest (dihedral) angle, monotone in it: minus the largest cosine of
@@ -588,7 +583,7 @@ std::int64_t PerturbSlivers(Smoother& s, double sliverAngle, int passes, const P
 }
 } // namespace
 
-std::string ValidateParameters(const MeshSmoothingParameters& p)
+std::string ValidateParameters(const ImageMeshSmoothingParameters& p)
 {
   if (p.Iterations < 0 || p.Iterations > 100)
   {
@@ -619,29 +614,6 @@ std::string ValidateParameters(const MeshSmoothingParameters& p)
     return "the sliver angle must be in [0, 30] degrees.";
   }
   return std::string();
-}
-
-std::vector<std::uint8_t> FreeAxes(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, bool fixedMayMove)
-{
-  const ImageGeometry& g = mesh.Geometry();
-  const int dimension = g.Dimension();
-  const auto& P = mesh.Points();
-  std::vector<std::uint8_t> free(P.size(), 0);
-  for (size_t i = 0; i < P.size(); ++i)
-  {
-    if (i < fixed.size() && fixed[i] && !fixedMayMove)
-    {
-      continue;
-    }
-    for (int a = 0; a < dimension; ++a)
-    {
-      if (P[i][a] != 0.0 && P[i][a] != g.Dims[a] - 1.0)
-      {
-        free[i] |= static_cast<std::uint8_t>(1 << a);
-      }
-    }
-  }
-  return free;
 }
 
 double ElementDensity(const SimplexMesh& mesh, const std::vector<V3>& points, std::int64_t element, const float* gradient,
@@ -731,10 +703,10 @@ V3 SmoothingTarget(const SimplexMesh& mesh, const std::vector<V3>& points, const
   return g.FrameToIndex({ { sum[0] / weightSum, sum[1] / weightSum, sum[2] / weightSum } });
 }
 
-MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, const float* values,
-  const MeshSmoothingParameters& p, const ParallelFor& parallel, const ProgressFunction& progress)
+ImageMeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, const float* values,
+  const ImageMeshSmoothingParameters& p, const ParallelFor& parallel, const ProgressFunction& progress)
 {
-  MeshSmoothingResult result;
+  ImageMeshSmoothingResult result;
   using Clock = std::chrono::steady_clock;
   auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   auto t0 = Clock::now();
@@ -914,7 +886,7 @@ MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<s
         // Re-tetrahedralise the moved nodes (CGAL; the same ids, so node arrays still apply).
         std::vector<V3> frame(s.Points.size());
         std::transform(s.Points.begin(), s.Points.end(), frame.begin(), [&](const V3& q) { return g.IndexToFrame(q); });
-        DelaunayOptions o;
+        DelaunayImageMeshParameters o;
         o.Backend = DelaunayBackend::CGAL;
         // CGAL has no progress or abort of its own: it runs beside a heartbeat.
         DelaunayResult d;
@@ -952,7 +924,7 @@ MeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<s
     }
     std::vector<V3> frame(s.Points.size());
     std::transform(s.Points.begin(), s.Points.end(), frame.begin(), [&](const V3& q) { return g.IndexToFrame(q); });
-    DelaunayOptions o;
+    DelaunayImageMeshParameters o;
     o.QualityRefinement = true;
     o.MinDihedralAngle = p.MinDihedralAngle;
     o.RadiusEdgeRatio = p.RadiusEdgeRatio;

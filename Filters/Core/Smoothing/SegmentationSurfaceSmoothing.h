@@ -38,7 +38,7 @@ enum class SurfaceSmoothingMethod
   Taubin = 1     // lambda then mu per iteration: no shrinkage
 };
 
-struct SurfaceSmoothingParameters
+struct SegmentationSurfaceSmoothingParameters
 {
   SurfaceSmoothingMethod Method = SurfaceSmoothingMethod::Laplacian;
   // Thesis 4.4: three iterations of relaxation 0.5.
@@ -57,9 +57,9 @@ struct SurfaceSmoothingParameters
 };
 
 // Empty when usable, else a sentence naming the bad parameter.
-std::string ValidateParameters(const SurfaceSmoothingParameters& parameters);
+std::string ValidateParameters(const SegmentationSurfaceSmoothingParameters& parameters);
 
-struct SurfaceSmoothingResult
+struct SegmentationSurfaceSmoothingResult
 {
   // Index-space points of the labelled mesh (moved when VolumeMesh, else as before) and the
   // boundary's positions: equal to Points on the boundary nodes when VolumeMesh.
@@ -89,7 +89,7 @@ struct SurfaceSmoothingResult
 // curve only (the mean of its two curve neighbours), and where more meet, or a curve ends or
 // branches (a junction point), it stays: the vertex classification of vtkWindowedSincPolyDataFilter's
 // feature edges. ObjectMeasure is then the elements' measure summed over labels 1..k.
-SurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const std::vector<std::uint8_t>& label,
-  const SurfaceSmoothingParameters& parameters, const ParallelFor& parallel,
+SegmentationSurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const std::vector<std::uint8_t>& label,
+  const SegmentationSurfaceSmoothingParameters& parameters, const ParallelFor& parallel,
   const ProgressFunction& progress = NoProgress());
 } // namespace featuremesh
