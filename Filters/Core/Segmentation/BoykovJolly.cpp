@@ -5,6 +5,7 @@
 #include <maxflow.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -685,6 +686,279 @@ bool BinBoundedVoxels(const NodeVoxelValues& voxels, const HistogramBins& bin, M
   });
   return progress(1.0);
 }
+// Reports progress at step i of count (begin..end) every CheckEvery + 1 steps; false once abort is asked.
+bool KeepGoing(const ProgressFunction& progress, std::int64_t i, std::int64_t count, double begin, double end)
+{
+  return (i & CheckEvery) != CheckEvery ||
+    progress(begin + (end - begin) * static_cast<double>(i) / static_cast<double>(count));
+}
+
+// Step 1: the histogram's range, the values' 0.5 and 99.5 percentiles (the exact voxels' when the
+// nodes carry them) widened to every seed sample.
+std::array<double, 2> HistogramRange(const CutProblem& pr)
+{
+  const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
+  const NodeVoxelValues* exact = pr.NodeVoxels;
+  double low = exact ? exact->Low : StridedPercentile(pr.Value.data(), n, 0.5);
+  double high = exact ? exact->High : StridedPercentile(pr.Value.data(), n, 99.5);
+  for (const std::vector<double>* samples : { &pr.ObjectSamples, &pr.BackgroundSamples })
+  {
+    for (double v : *samples)
+    {
+      low = std::min(low, v);
+      high = std::max(high, v);
+    }
+  }
+  return { { low, high > low ? high : low + 1.0 } };
+}
+
+// Step 2: each label's cost -ln Pr(bin | label) from its seeds' smoothed histogram.
+struct BinCosts
+{
+  std::vector<double> Object, Background;
+};
+BinCosts LabelBinCosts(const CutProblem& pr, double low, double high, int bins, double bandwidth)
+{
+  const std::vector<double> pObject = SmoothedHistogram(pr.ObjectSamples, pr.ObjectWeights, low, high, bins, bandwidth);
+  const std::vector<double> pBackground = SmoothedHistogram(pr.BackgroundSamples, pr.BackgroundWeights, low, high, bins, bandwidth);
+  BinCosts costs{ std::vector<double>(bins), std::vector<double>(bins) };
+  for (int b = 0; b < bins; ++b)
+  {
+    costs.Object[b] = -std::log(pObject[b]);
+    costs.Background[b] = -std::log(pBackground[b]);
+  }
+  return costs;
+}
+
+// Step 3: the boundary weights w = contact x exp(-d^2 / 2 sigma^2), sigma the RMS neighbour
+// difference when not given, and 1 + their sum (the start of K). False when progress asked to abort.
+struct BoundaryTerm
+{
+  double Sigma = 0.0, Total = 1.0;
+  std::unique_ptr<double[]> Weight;
+};
+bool BoundaryWeights(const CutProblem& pr, double sigma, BoundaryTerm& out, const ProgressFunction& progress)
+{
+  const GraphEdges& edges = pr.Edges;
+  const std::int64_t m = edges.Size();
+  out.Sigma = sigma;
+  if (out.Sigma <= 0.0)
+  {
+    double ss = 0.0;
+    edges.ForEach([&](std::int64_t, std::int64_t a, std::int64_t b) {
+      const double d = pr.Value[a] - pr.Value[b];
+      ss += d * d;
+    });
+    out.Sigma = m ? std::sqrt(ss / static_cast<double>(m)) : 1.0;
+    if (!(out.Sigma > 0.0))
+    {
+      out.Sigma = 1.0;
+    }
+  }
+  const double inv2s2 = 1.0 / (2.0 * out.Sigma * out.Sigma);
+  if (!progress(0.0))
+  {
+    return false;
+  }
+  // Not zero-filled: its pages are first touched in the loop below, which reports progress. The
+  // exponentials run on pr.Parallel; the sum stays in edge order (the same total for any split).
+  out.Weight.reset(new double[m]);
+  double* weight = out.Weight.get();
+  if (!BatchedFor(edges.Blocks(), 1, pr.Parallel, progress, [&](std::int64_t first, std::int64_t last) {
+        edges.ForEach(first, last, [&](std::int64_t e, std::int64_t a, std::int64_t b) {
+          const double d = pr.Value[a] - pr.Value[b];
+          // Equal neighbours have weight 1 whatever sigma (a tiny sigma would give 0 * inf).
+          const double contact = pr.Contact.empty() ? 1.0 : pr.Contact[e];
+          weight[e] = contact * (d == 0.0 ? 1.0 : std::exp(-d * d * inv2s2));
+        });
+      }))
+  {
+    return false;
+  }
+  out.Total = 1.0;
+  for (std::int64_t e = 0; e < m; ++e)
+  {
+    out.Total += weight[e];
+  }
+  return true;
+}
+
+// Step 4 for exact super-voxels: each node's region costs summed over its voxels' bins. The bins
+// move only when a seed sample leaves the last cut's range. Sorted values are summed straight from
+// the values for a binning seen for the first time, and kept as runs once it repeats; bounded ones
+// are binned at once (a pass over the voxels), and the runs kept. False when progress asked to abort.
+bool ExactRegionCosts(const CutProblem& pr, const HistogramBins& bin, const BinCosts& costs, double low, double width,
+  std::shared_ptr<MaxFlowCache::BinnedVoxels>* kept, double* regionObject, double* regionBackground,
+  const ProgressFunction& progress)
+{
+  const NodeVoxelValues* exact = pr.NodeVoxels;
+  const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
+  const int bins = static_cast<int>(costs.Object.size());
+  std::shared_ptr<MaxFlowCache::BinnedVoxels> binned = kept ? *kept : nullptr;
+  const bool repeated = binned && binned->Matches(exact, bins, low, width);
+  if (!repeated)
+  {
+    if (kept)
+    {
+      kept->reset(); // the old runs' memory goes before the new runs are made
+    }
+    binned = std::make_shared<MaxFlowCache::BinnedVoxels>();
+    binned->From = exact;
+    binned->Nodes = exact->Nodes;
+    binned->Bins = bins;
+    binned->Low = low;
+    binned->Width = width;
+    if (kept)
+    {
+      *kept = binned;
+    }
+  }
+  if (binned->Empty() && (repeated || !exact->Sorted()) &&
+    !(exact->Sorted() ? BinSortedVoxels(*exact, bin, *binned, pr.Parallel, SubProgress(progress, 0.0, 0.8))
+                      : BinBoundedVoxels(*exact, bin, *binned, pr.Parallel, SubProgress(progress, 0.0, 0.8))))
+  {
+    if (kept)
+    {
+      kept->reset();
+    }
+    return false;
+  }
+  return !binned->Empty()
+    ? BatchedFor(n, 16384, pr.Parallel, SubProgress(progress, 0.8, 1.0),
+        [&](std::int64_t first, std::int64_t last) {
+          for (std::int64_t p = first; p < last; ++p)
+          {
+            double sumObject = 0.0, sumBackground = 0.0;
+            for (std::int64_t k = binned->Offset[p]; k < binned->Offset[p + 1]; ++k)
+            {
+              const double count = static_cast<double>(binned->Count[k]);
+              sumObject += count * costs.Object[binned->Bin[k]];
+              sumBackground += count * costs.Background[binned->Bin[k]];
+            }
+            regionObject[p] = sumObject;
+            regionBackground[p] = sumBackground;
+          }
+        })
+    : exact->Visit([&](const auto* all) {
+        return BatchedFor(n, 8192, pr.Parallel, progress, [&](std::int64_t first, std::int64_t last) {
+          for (std::int64_t p = first; p < last; ++p)
+          {
+            double sumObject = 0.0, sumBackground = 0.0;
+            ForEachRun(all + exact->Offset[p], all + exact->Offset[p + 1], bin, [&](int b, std::uint32_t count) {
+              sumObject += static_cast<double>(count) * costs.Object[b];
+              sumBackground += static_cast<double>(count) * costs.Background[b];
+            });
+            regionObject[p] = sumObject;
+            regionBackground[p] = sumBackground;
+          }
+        });
+      });
+}
+
+// Step 4: the region costs of each node, object and background (before lambda): its voxels' sum
+// (exact super-voxels) or its size times its value's bin cost. False when progress asked to abort.
+bool RegionCosts(const CutProblem& pr, const HistogramBins& bin, const BinCosts& costs, double low, double width,
+  std::shared_ptr<MaxFlowCache::BinnedVoxels>* kept, double* regionObject, double* regionBackground,
+  const ProgressFunction& progress)
+{
+  if (pr.NodeVoxels)
+  {
+    return ExactRegionCosts(pr, bin, costs, low, width, kept, regionObject, regionBackground, progress);
+  }
+  const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    const int b = bin(pr.Value[p]);
+    const double size = pr.Size.empty() ? 1.0 : pr.Size[p];
+    regionObject[p] = size * costs.Object[b];
+    regionBackground[p] = size * costs.Background[b];
+    if (!KeepGoing(progress, p, n, 0.0, 1.0))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Step 5: the seeds' spatial term added to the region costs; it moves terminal capacities only, so
+// a kept flow still applies. False when progress asked to abort.
+bool AddSeedGeodesicTerm(const CutProblem& pr, double range, SeedGeodesicCache* kept, double* regionObject,
+  double* regionBackground, const ProgressFunction& progress)
+{
+  GeodesicGraph graph;
+  graph.Edges = &pr.Edges;
+  graph.Value = pr.Value.data();
+  graph.Nodes = static_cast<std::int64_t>(pr.Value.size());
+  graph.Step = &pr.Step;
+  std::vector<double> spatialObject, spatialBackground;
+  if (!SeedGeodesicCosts(graph, pr.Hard, range, pr.Geodesic, pr.Parallel, spatialObject, spatialBackground, progress, kept))
+  {
+    return false;
+  }
+  for (std::int64_t p = 0; p < static_cast<std::int64_t>(spatialObject.size()); ++p)
+  {
+    const double size = pr.Size.empty() ? 1.0 : pr.Size[p];
+    regionObject[p] += size * spatialObject[p];
+    regionBackground[p] += size * spatialBackground[p];
+  }
+  return true;
+}
+
+// Step 6 on a kept flow (Kohli-Torr): the residual graph takes the capacity changes as signed
+// terminal residuals; only nodes whose residual changes sign (or zero status) need their search
+// trees redone.
+template <typename Source, typename Sink>
+void UpdateTerminals(Flow& g, const MaxFlowCache::Kept& kept, std::int64_t n, const Source& source, const Sink& sink)
+{
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    const double ds = source(p) - kept.Source[p], dt = sink(p) - kept.Sink[p];
+    if (ds != 0.0 || dt != 0.0)
+    {
+      const double before = g.get_trcap(static_cast<int>(p));
+      g.add_tweights(static_cast<int>(p), ds, dt);
+      const double after = g.get_trcap(static_cast<int>(p));
+      if ((before > 0) != (after > 0) || (before < 0) != (after < 0))
+      {
+        g.mark_node(static_cast<int>(p));
+      }
+    }
+  }
+}
+
+// Step 6: a new max-flow graph, its nodes' terminal capacities and its edges' weights. Null when
+// progress asked to abort; throws when memory runs out.
+template <typename Source, typename Sink>
+std::shared_ptr<Flow> NewFlowGraph(const GraphEdges& edges, const double* weight, std::int64_t n, const Source& source,
+  const Sink& sink, const ProgressFunction& progress)
+{
+  auto g = std::make_shared<Flow>(static_cast<int>(n), static_cast<int>(edges.Size()), ThrowOutOfMemory);
+  // Nodes in chunks (the same ids as one call): first touching a 9 M-voxel graph's memory takes
+  // seconds, and progress must keep coming.
+  constexpr std::int64_t chunk = std::int64_t(1) << 20;
+  for (std::int64_t p = 0; p < n; p += chunk)
+  {
+    g->add_node(static_cast<int>(std::min(chunk, n - p)));
+    if (!progress(0.3 * static_cast<double>(p) / static_cast<double>(n)))
+    {
+      return nullptr;
+    }
+  }
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    if (!KeepGoing(progress, p, n, 0.3, 0.6))
+    {
+      return nullptr;
+    }
+    g->add_tweights(static_cast<int>(p), source(p), sink(p));
+  }
+  const bool done = edges.ForEachUntil(
+    [&](std::int64_t e, std::int64_t a, std::int64_t b) {
+      g->add_edge(static_cast<int>(a), static_cast<int>(b), weight[e], weight[e]);
+    },
+    [&](double t) { return progress(0.6 + 0.4 * t); });
+  return done ? g : nullptr;
+}
 } // namespace
 
 CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par, const ProgressFunction& progress,
@@ -710,228 +984,65 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   {
     return r;
   }
-  // Every loop below checks for an abort every CheckEvery + 1 steps.
-  auto aborted = [&](std::int64_t i, std::int64_t count, double begin, double end) {
-    if ((i & CheckEvery) != CheckEvery)
-    {
-      return false;
-    }
-    r.Aborted = !progress(begin + (end - begin) * static_cast<double>(i) / static_cast<double>(count));
+  // A phase that returns false was aborted.
+  auto aborted = [&](bool goOn) {
+    r.Aborted = !goOn;
     return r.Aborted;
   };
-  // And at the end of every phase.
-  auto phaseAborted = [&](double done) {
-    r.Aborted = !progress(done);
-    return r.Aborted;
-  };
-  if (phaseAborted(0.05))
+  if (aborted(progress(0.05)))
   {
     return r;
   }
-  const NodeVoxelValues* exact = pr.NodeVoxels;
-  double low = exact ? exact->Low : StridedPercentile(pr.Value.data(), n, 0.5);
-  double high = exact ? exact->High : StridedPercentile(pr.Value.data(), n, 99.5);
-  for (double v : pr.ObjectSamples)
-  {
-    low = std::min(low, v);
-    high = std::max(high, v);
-  }
-  for (double v : pr.BackgroundSamples)
-  {
-    low = std::min(low, v);
-    high = std::max(high, v);
-  }
-  if (!(high > low))
-  {
-    high = low + 1.0;
-  }
+  // 1-2. The histogram and each label's cost per bin.
+  const std::array<double, 2> range = HistogramRange(pr);
+  const double low = range[0], high = range[1];
   r.Bins = par.Bins > 0 ? par.Bins
                         : AutomaticBins({ { &pr.ObjectSamples, &pr.ObjectWeights }, { &pr.BackgroundSamples, &pr.BackgroundWeights } },
                             low, high, par.Bandwidth);
-  const std::vector<double> pObject = SmoothedHistogram(pr.ObjectSamples, pr.ObjectWeights, low, high, r.Bins, par.Bandwidth);
-  const std::vector<double> pBackground =
-    SmoothedHistogram(pr.BackgroundSamples, pr.BackgroundWeights, low, high, r.Bins, par.Bandwidth);
-  std::vector<double> costObject(r.Bins), costBackground(r.Bins);
-  for (int b = 0; b < r.Bins; ++b)
-  {
-    costObject[b] = -std::log(pObject[b]);
-    costBackground[b] = -std::log(pBackground[b]);
-  }
+  const BinCosts costs = LabelBinCosts(pr, low, high, r.Bins, par.Bandwidth);
   const double width = (high - low) / r.Bins;
   const HistogramBins bin(r.Bins, low, width);
 
-  // The boundary term depends on the graph alone: a kept flow of this very graph lends its weights
-  // (and its residual graph, below).
+  // 3. The boundary term depends on the graph alone: a kept flow of this very graph lends its
+  // weights (and its residual graph, below).
   std::shared_ptr<MaxFlowCache::Kept> kept = cache ? cache->State : nullptr;
   const bool reuse = kept && kept->SigmaParameter == par.Sigma && kept->Edges.Same(edges) && kept->Value == pr.Value &&
     kept->Contact == pr.Contact;
-  std::unique_ptr<double[]> computed;
-  const double* weight = nullptr;
-  double total = 1.0;
+  BoundaryTerm boundary;
   if (reuse)
   {
-    r.Sigma = kept->Sigma;
-    weight = kept->Weight.get();
-    total = kept->WeightTotal;
+    boundary.Sigma = kept->Sigma;
+    boundary.Total = kept->WeightTotal;
   }
-  else
-  {
-    r.Sigma = par.Sigma;
-    if (r.Sigma <= 0.0)
-    {
-      double ss = 0.0;
-      edges.ForEach([&](std::int64_t, std::int64_t a, std::int64_t b) {
-        const double d = pr.Value[a] - pr.Value[b];
-        ss += d * d;
-      });
-      r.Sigma = m ? std::sqrt(ss / static_cast<double>(m)) : 1.0;
-      if (!(r.Sigma > 0.0))
-      {
-        r.Sigma = 1.0;
-      }
-    }
-    const double inv2s2 = 1.0 / (2.0 * r.Sigma * r.Sigma);
-    if (phaseAborted(0.1))
-    {
-      return r;
-    }
-    // Not zero-filled: its pages are first touched in the loop below, which reports progress. The
-    // exponentials run on pr.Parallel; the sum stays in edge order (the same total for any split).
-    computed.reset(new double[m]);
-    weight = computed.get();
-    if (!BatchedFor(edges.Blocks(), 1, pr.Parallel, SubProgress(progress, 0.1, 0.2), [&](std::int64_t first, std::int64_t last) {
-          edges.ForEach(first, last, [&](std::int64_t e, std::int64_t a, std::int64_t b) {
-            const double d = pr.Value[a] - pr.Value[b];
-            // Equal neighbours have weight 1 whatever sigma (a tiny sigma would give 0 * inf).
-            const double contact = pr.Contact.empty() ? 1.0 : pr.Contact[e];
-            computed[e] = contact * (d == 0.0 ? 1.0 : std::exp(-d * d * inv2s2));
-          });
-        }))
-    {
-      r.Aborted = true;
-      return r;
-    }
-    for (std::int64_t e = 0; e < m; ++e)
-    {
-      total += weight[e];
-    }
-  }
-  if (phaseAborted(0.2))
+  else if (aborted(progress(0.1)) || aborted(BoundaryWeights(pr, par.Sigma, boundary, SubProgress(progress, 0.1, 0.2))))
   {
     return r;
   }
-  // Region costs of each node: labelled object it pays regionObject, labelled background regionBackground.
-  // Not zero-filled unless summed into: a 9 M-voxel graph's pages are first touched in loops that
-  // report progress.
+  r.Sigma = boundary.Sigma;
+  const double* weight = reuse ? kept->Weight.get() : boundary.Weight.get();
+  double total = boundary.Total;
+  if (aborted(progress(0.2)))
+  {
+    return r;
+  }
+  // 4-5. Region costs of each node: labelled object it pays regionObject, labelled background
+  // regionBackground. Not zero-filled unless summed into: a 9 M-voxel graph's pages are first
+  // touched in loops that report progress.
   std::unique_ptr<double[]> regionObject(new double[n]), regionBackground(new double[n]);
   AdviseHugePages(regionObject.get(), n * sizeof(double));
   AdviseHugePages(regionBackground.get(), n * sizeof(double));
-  if (exact)
+  if (aborted(RegionCosts(pr, bin, costs, low, width, cache ? &cache->Binned : nullptr, regionObject.get(),
+        regionBackground.get(), SubProgress(progress, 0.2, 0.3))))
   {
-    // The bins move only when a seed sample leaves the last cut's range. Sorted values are summed
-    // straight from the values for a binning seen for the first time, and kept as runs once it
-    // repeats; bounded ones are binned at once (a pass over the voxels), and the runs kept.
-    std::shared_ptr<MaxFlowCache::BinnedVoxels> binned = cache ? cache->Binned : nullptr;
-    const bool repeated = binned && binned->Matches(exact, r.Bins, low, width);
-    if (!repeated)
-    {
-      if (cache)
-      {
-        cache->Binned.reset(); // the old runs' memory goes before the new runs are made
-      }
-      binned = std::make_shared<MaxFlowCache::BinnedVoxels>();
-      binned->From = exact;
-      binned->Nodes = exact->Nodes;
-      binned->Bins = r.Bins;
-      binned->Low = low;
-      binned->Width = width;
-      if (cache)
-      {
-        cache->Binned = binned;
-      }
-    }
-    if (binned->Empty() && (repeated || !exact->Sorted()) &&
-      !(exact->Sorted() ? BinSortedVoxels(*exact, bin, *binned, pr.Parallel, SubProgress(progress, 0.2, 0.28))
-                        : BinBoundedVoxels(*exact, bin, *binned, pr.Parallel, SubProgress(progress, 0.2, 0.28))))
-    {
-      if (cache)
-      {
-        cache->Binned.reset();
-      }
-      r.Aborted = true;
-      return r;
-    }
-    const bool done = !binned->Empty()
-      ? BatchedFor(n, 16384, pr.Parallel, SubProgress(progress, 0.28, 0.3),
-          [&](std::int64_t first, std::int64_t last) {
-            for (std::int64_t p = first; p < last; ++p)
-            {
-              double sumObject = 0.0, sumBackground = 0.0;
-              for (std::int64_t k = binned->Offset[p]; k < binned->Offset[p + 1]; ++k)
-              {
-                const double count = static_cast<double>(binned->Count[k]);
-                sumObject += count * costObject[binned->Bin[k]];
-                sumBackground += count * costBackground[binned->Bin[k]];
-              }
-              regionObject[p] = sumObject;
-              regionBackground[p] = sumBackground;
-            }
-          })
-      : exact->Visit([&](const auto* all) {
-          return BatchedFor(n, 8192, pr.Parallel, SubProgress(progress, 0.2, 0.3), [&](std::int64_t first, std::int64_t last) {
-            for (std::int64_t p = first; p < last; ++p)
-            {
-              double sumObject = 0.0, sumBackground = 0.0;
-              ForEachRun(all + exact->Offset[p], all + exact->Offset[p + 1], bin, [&](int b, std::uint32_t count) {
-                sumObject += static_cast<double>(count) * costObject[b];
-                sumBackground += static_cast<double>(count) * costBackground[b];
-              });
-              regionObject[p] = sumObject;
-              regionBackground[p] = sumBackground;
-            }
-          });
-        });
-    if (!done)
-    {
-      r.Aborted = true;
-      return r;
-    }
-  }
-  else
-  {
-    for (std::int64_t p = 0; p < n; ++p)
-    {
-      const int b = bin(pr.Value[p]);
-      const double size = pr.Size.empty() ? 1.0 : pr.Size[p];
-      regionObject[p] = size * costObject[b];
-      regionBackground[p] = size * costBackground[b];
-      if (aborted(p, n, 0.2, 0.3))
-      {
-        return r;
-      }
-    }
+    return r;
   }
   if (pr.Geodesic.Weight > 0.0)
   {
-    // The seeds' spatial term: it moves terminal capacities only, so a kept flow still applies.
     const auto g0 = Clock::now();
-    GeodesicGraph graph;
-    graph.Edges = &edges;
-    graph.Value = pr.Value.data();
-    graph.Nodes = n;
-    graph.Step = &pr.Step;
-    std::vector<double> spatialObject, spatialBackground;
-    if (!SeedGeodesicCosts(graph, pr.Hard, high - low, pr.Geodesic, pr.Parallel, spatialObject, spatialBackground,
-          SubProgress(progress, 0.3, 0.33), cache ? &cache->Geodesic : nullptr))
+    if (aborted(AddSeedGeodesicTerm(pr, high - low, cache ? &cache->Geodesic : nullptr, regionObject.get(),
+          regionBackground.get(), SubProgress(progress, 0.3, 0.33))))
     {
-      r.Aborted = true;
       return r;
-    }
-    for (std::int64_t p = 0; p < static_cast<std::int64_t>(spatialObject.size()); ++p)
-    {
-      const double size = pr.Size.empty() ? 1.0 : pr.Size[p];
-      regionObject[p] += size * spatialObject[p];
-      regionBackground[p] += size * spatialBackground[p];
     }
     r.GeodesicSeconds = std::chrono::duration<double>(Clock::now() - g0).count();
   }
@@ -940,12 +1051,12 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     regionObject[p] *= par.Lambda;
     regionBackground[p] *= par.Lambda;
     total += std::max(regionObject[p], regionBackground[p]);
-    if (aborted(p, n, 0.33, 0.35))
+    if (aborted(KeepGoing(progress, p, n, 0.33, 0.35)))
     {
       return r;
     }
   }
-  if (phaseAborted(0.35))
+  if (aborted(progress(0.35)))
   {
     return r;
   }
@@ -956,10 +1067,10 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     r.Error = "the energy overflows (lambda, the contact areas or the graph are too large); lower lambda.";
     return r;
   }
-  // Terminal capacities (source = object: a node left on the source side pays its sink capacity).
+  // 6. Terminal capacities (source = object: a node left on the source side pays its sink
+  // capacity), on the kept flow when only they changed, else on a new graph.
   auto source = [&](std::int64_t p) { return pr.Hard[p] == 1 ? K : (pr.Hard[p] == 2 ? 0.0 : regionBackground[p]); };
   auto sink = [&](std::int64_t p) { return pr.Hard[p] == 2 ? K : (pr.Hard[p] == 1 ? 0.0 : regionObject[p]); };
-  // The kept flow applies when only terminal capacities changed: same graph, same weights.
   if (cache)
   {
     cache->State.reset(); // until this cut's flow has finished
@@ -969,54 +1080,13 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   {
     if (reuse)
     {
-      // Kohli-Torr: the residual graph takes the capacity changes as signed terminal residuals; only
-      // nodes whose residual changes sign (or zero status) need their search trees redone.
       g = kept->Graph;
-      for (std::int64_t p = 0; p < n; ++p)
-      {
-        const double ds = source(p) - kept->Source[p], dt = sink(p) - kept->Sink[p];
-        if (ds != 0.0 || dt != 0.0)
-        {
-          const double before = g->get_trcap(static_cast<int>(p));
-          g->add_tweights(static_cast<int>(p), ds, dt);
-          const double after = g->get_trcap(static_cast<int>(p));
-          if ((before > 0) != (after > 0) || (before < 0) != (after < 0))
-          {
-            g->mark_node(static_cast<int>(p));
-          }
-        }
-      }
+      UpdateTerminals(*g, *kept, n, source, sink);
     }
-    else
+    else if (!(g = NewFlowGraph(edges, weight, n, source, sink, SubProgress(progress, 0.35, 0.5))))
     {
-      g = std::make_shared<Flow>(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory);
-      // Nodes in chunks (the same ids as one call): first touching a 9 M-voxel graph's memory takes
-      // seconds, and progress must keep coming.
-      constexpr std::int64_t chunk = std::int64_t(1) << 20;
-      for (std::int64_t p = 0; p < n; p += chunk)
-      {
-        g->add_node(static_cast<int>(std::min(chunk, n - p)));
-        if (phaseAborted(0.35 + 0.05 * static_cast<double>(p) / static_cast<double>(n)))
-        {
-          return r;
-        }
-      }
-      for (std::int64_t p = 0; p < n; ++p)
-      {
-        if (aborted(p, n, 0.4, 0.45))
-        {
-          return r;
-        }
-        g->add_tweights(static_cast<int>(p), source(p), sink(p));
-      }
-      if (!edges.ForEachUntil(
-            [&](std::int64_t e, std::int64_t a, std::int64_t b) {
-              g->add_edge(static_cast<int>(a), static_cast<int>(b), weight[e], weight[e]);
-            },
-            [&](double t) { return !phaseAborted(0.45 + 0.05 * t); }))
-      {
-        return r;
-      }
+      r.Aborted = true;
+      return r;
     }
   }
   catch (const std::exception&)
@@ -1026,7 +1096,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   }
   const auto t1 = Clock::now();
   r.GraphSeconds = std::chrono::duration<double>(t1 - t0).count();
-  // The max-flow has no progress or abort of its own: it runs on its own thread, owning the graph.
+  // 7. The max-flow has no progress or abort of its own: it runs on its own thread, owning the graph.
   using FlowResult = std::pair<double, std::vector<std::uint8_t>>;
   FlowResult flow;
   try
@@ -1043,9 +1113,8 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
         return f;
       },
       SubProgress(progress, 0.5, 1.0), flow);
-    if (!done)
+    if (aborted(done))
     {
-      r.Aborted = true;
       return r;
     }
   }
@@ -1056,6 +1125,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   }
   r.Flow = flow.first;
   r.Label = std::move(flow.second);
+  // 8. What a re-cut with other seeds reuses: the graph, its weights and its capacities.
   if (cache)
   {
     if (!reuse)
@@ -1071,7 +1141,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
       kept->SigmaParameter = par.Sigma;
       kept->Sigma = r.Sigma;
       kept->WeightTotal = total;
-      kept->Weight = std::move(computed);
+      kept->Weight = std::move(boundary.Weight);
     }
     kept->Graph = g;
     kept->Source.resize(n);
