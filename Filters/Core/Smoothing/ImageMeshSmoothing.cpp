@@ -703,6 +703,269 @@ V3 SmoothingTarget(const SimplexMesh& mesh, const std::vector<V3>& points, const
   return g.FrameToIndex({ { sum[0] / weightSum, sum[1] / weightSum, sum[2] / weightSum } });
 }
 
+namespace
+{
+// Step 1: the smoothed image (the fixed nodes' slide normals) and its gradient magnitude (the
+// density), each made only when a parameter asks for it. False when progress asked to abort.
+struct FeatureImages
+{
+  std::vector<float> Smoothed, Gradient;
+  double MeanGradient = 0.0;
+};
+bool MakeFeatureImages(const float* values, const ImageGeometry& g, const ImageMeshSmoothingParameters& p,
+  const ParallelFor& parallel, const ProgressFunction& progress, FeatureImages& out)
+{
+  if ((p.FeatureWeight != 0.0 || p.FixedNodeSlack > 0.0) && p.Iterations > 0)
+  {
+    AssignFresh(out.Smoothed, static_cast<size_t>(g.Size()));
+    GaussianSmooth(values, out.Smoothed.data(), g, p.Sigma, parallel);
+    if (!progress(0.0))
+    {
+      return false;
+    }
+  }
+  if (p.FeatureWeight != 0.0 && p.Iterations > 0)
+  {
+    AssignFresh(out.Gradient, out.Smoothed.size());
+    GradientMagnitude(out.Smoothed.data(), g, out.Gradient.data(), parallel);
+    out.MeanGradient = std::accumulate(out.Gradient.begin(), out.Gradient.end(), 0.0) / static_cast<double>(out.Gradient.size());
+  }
+  return true;
+}
+
+// Step 2: fixed nodes that may slide (FixedNodeSlack) move only across the image's edge: each gets
+// the smoothed image's gradient direction as its normal; without one it stays.
+void SetSlideNormals(Smoother& s, const std::vector<std::uint8_t>& fixed, const std::vector<std::uint8_t>& freeAxes,
+  const std::vector<float>& smoothed, const ImageGeometry& g, double slack)
+{
+  const std::int64_t n = static_cast<std::int64_t>(s.Points.size());
+  const int vpc = s.Topology.VerticesPerCell();
+  // Voxels to frame units: the finest spacing of the image's axes.
+  double finest = std::min(std::fabs(g.Spacing[0]), std::fabs(g.Spacing[1]));
+  finest = g.Is2D() ? finest : std::min(finest, std::fabs(g.Spacing[2]));
+  s.Slack = slack * finest;
+  s.Normal.assign(n, V3{ { 0, 0, 0 } });
+  for (std::int64_t v = 0; v < n; ++v)
+  {
+    if (v >= static_cast<std::int64_t>(fixed.size()) || !fixed[v] || !freeAxes[v])
+    {
+      continue;
+    }
+    // Central differences of the smoothed image at the node, per frame unit.
+    V3 normal = { { 0, 0, 0 } };
+    for (int a = 0; a < vpc - 1; ++a)
+    {
+      double lo[3] = { s.Anchor[v][0], s.Anchor[v][1], s.Anchor[v][2] }, hi[3] = { lo[0], lo[1], lo[2] };
+      lo[a] -= 0.5;
+      hi[a] += 0.5;
+      normal[a] = (InterpolateAt(smoothed.data(), g, hi) - InterpolateAt(smoothed.data(), g, lo)) / std::fabs(g.Spacing[a]);
+    }
+    const double length = std::sqrt(Dot(normal, normal));
+    if (length > 0.0)
+    {
+      s.Normal[v] = { { normal[0] / length, normal[1] / length, normal[2] / length } };
+    }
+    else
+    {
+      s.Free[v] = 0; // no edge direction: stays fixed
+    }
+  }
+}
+
+// Step 3a: multicolour Gauss-Seidel classes. Nodes of one colour share no element, so they move at
+// once (any thread count gives the same result); colours greedily in node order, classes in colour
+// order: class c is byColour[start[c] .. start[c + 1]).
+void ColourClasses(const Smoother& s, std::vector<std::int64_t>& start, std::vector<std::int64_t>& byColour)
+{
+  const CompressedRows& stars = s.Topology.Stars();
+  const std::int64_t n = static_cast<std::int64_t>(s.Points.size());
+  const int vpc = s.Topology.VerticesPerCell();
+  std::vector<int> colour(n, -1);
+  std::vector<int> lastSeen;
+  int colours = 0;
+  for (std::int64_t v = 0; v < n; ++v)
+  {
+    if (!s.Free[v] || stars.Size(v) == 0)
+    {
+      continue;
+    }
+    // Neighbours through the star (cheaper than building the vertex-neighbour rows).
+    for (const std::int64_t* e = stars.Begin(v); e != stars.End(v); ++e)
+    {
+      const std::int64_t* cell = s.Topology.Cell(*e);
+      for (int k = 0; k < vpc; ++k)
+      {
+        if (colour[cell[k]] >= 0)
+        {
+          lastSeen[colour[cell[k]]] = static_cast<int>(v);
+        }
+      }
+    }
+    int c = 0;
+    while (c < colours && lastSeen[c] == v)
+    {
+      ++c;
+    }
+    if (c == colours)
+    {
+      ++colours;
+      lastSeen.push_back(-1);
+    }
+    colour[v] = c;
+  }
+  start.assign(colours + 1, 0);
+  for (std::int64_t v = 0; v < n; ++v)
+  {
+    start[colour[v] + 1] += colour[v] >= 0 ? 1 : 0;
+  }
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  byColour.resize(start[colours]);
+  std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
+  for (std::int64_t v = 0; v < n; ++v)
+  {
+    if (colour[v] >= 0)
+    {
+      byColour[fill[colour[v]]++] = v;
+    }
+  }
+}
+
+// Step 3b: one sweep, every free node moved towards its star's CVT/ODT target (the elements'
+// densities computed when a node first needs them). `progress` spans the sweep; false when it
+// asked to abort.
+bool Sweep(Smoother& s, const FeatureImages& images, const ImageMeshSmoothingParameters& p, const ParallelFor& parallel,
+  const ProgressFunction& progress, std::vector<std::uint8_t>& moved)
+{
+  const CompressedRows& stars = s.Topology.Stars();
+  std::vector<double> elementDensity(s.Topology.NumberOfElements(), -1.0);
+  std::fill(moved.begin(), moved.end(), 0);
+  std::vector<std::int64_t> classStart, byColour;
+  ColourClasses(s, classStart, byColour);
+  const int colours = static_cast<int>(classStart.size()) - 1;
+  s.Score.assign(s.Topology.NumberOfElements(), Stale);
+  for (int c = 0; c < colours; ++c)
+  {
+    if (!progress(0.9 * c / static_cast<double>(colours)))
+    {
+      return false;
+    }
+    parallel(classStart[c + 1] - classStart[c], 256, [&](std::int64_t b, std::int64_t e) {
+      std::vector<double> density;
+      for (std::int64_t i = classStart[c] + b; i < classStart[c] + e; ++i)
+      {
+        const std::int64_t v = byColour[i];
+        const std::int64_t* star = stars.Begin(v);
+        const std::int64_t size = stars.Size(v);
+        density.resize(size);
+        for (std::int64_t k = 0; k < size; ++k)
+        {
+          double& rho = elementDensity[star[k]];
+          if (rho < 0.0)
+          {
+            rho = images.Gradient.empty()
+              ? 1.0
+              : ElementDensity(s.Topology, s.Points, star[k], images.Gradient.data(), images.MeanGradient, p.FeatureWeight);
+          }
+          density[k] = rho;
+        }
+        const V3 target = SmoothingTarget(s.Topology, s.Points, star, size, density.data(), p.Method);
+        if (std::isfinite(target[0]) && s.TryMove(v, target, star, size))
+        {
+          moved[v] = 1;
+        }
+      }
+    });
+  }
+  return true;
+}
+
+// Step 3c: the Delaunay property back after a sweep: flips in 2D, CGAL's triangulation of the moved
+// nodes in 3D (the same ids, so node arrays still apply). False with `error` or when aborted.
+bool RestoreDelaunay(Smoother& s, const std::vector<std::uint8_t>& moved, std::vector<std::int64_t>& neighbours,
+  const ProgressFunction& progress, std::int64_t& flips, bool& aborted, std::string& error)
+{
+  const ImageGeometry& g = s.Topology.Geometry();
+  const int vpc = s.Topology.VerticesPerCell();
+  std::vector<std::int64_t> cells = s.Topology.Cells();
+  if (vpc == 3)
+  {
+    flips += DelaunayFlips(g, s.Points, moved, cells, neighbours);
+  }
+  else
+  {
+    std::vector<V3> frame(s.Points.size());
+    std::transform(s.Points.begin(), s.Points.end(), frame.begin(), [&](const V3& q) { return g.IndexToFrame(q); });
+    DelaunayImageMeshParameters o;
+    o.Backend = DelaunayBackend::CGAL;
+    // CGAL has no progress or abort of its own: it runs beside a heartbeat.
+    DelaunayResult d;
+    if (!RunWithHeartbeat<DelaunayResult>([frame, o]() { return Tetrahedralize(frame, o); }, progress, d))
+    {
+      aborted = true;
+      return false;
+    }
+    if (!d.Error.empty() || d.Points.size() != frame.size())
+    {
+      error = "re-tetrahedralising the moved nodes failed: " + d.Error;
+      return false;
+    }
+    cells = std::move(d.Cells);
+  }
+  // Positive orientation in frame coordinates is positive in index space (positive scales).
+  s.Topology = SimplexMesh(g, s.Points, std::move(cells), vpc);
+  return true;
+}
+
+// Step 4: quality refinement to the angle bounds (CGAL's 2D mesher, TetGen in 3D after snapping
+// nodes near the box onto it); the added nodes are free. False with result.Error or when aborted.
+bool RefineQuality(Smoother& s, const std::vector<std::uint8_t>& fixed, const ImageMeshSmoothingParameters& p,
+  const ProgressFunction& progress, ImageMeshSmoothingResult& result)
+{
+  const ImageGeometry& g = s.Topology.Geometry();
+  const int vpc = s.Topology.VerticesPerCell();
+  if (vpc == 4)
+  {
+    result.SnappedNodes = SnapNodesToBox(g, s.Points);
+  }
+  std::vector<V3> frame(s.Points.size());
+  std::transform(s.Points.begin(), s.Points.end(), frame.begin(), [&](const V3& q) { return g.IndexToFrame(q); });
+  DelaunayImageMeshParameters o;
+  o.QualityRefinement = true;
+  o.MinDihedralAngle = p.MinDihedralAngle;
+  o.RadiusEdgeRatio = p.RadiusEdgeRatio;
+  o.PreserveBoundary = true;
+  const double minAngle = p.MinAngle;
+  const bool planar = vpc == 3;
+  // TetGen and CGAL's mesher have no progress or abort of their own: they run beside a heartbeat.
+  DelaunayResult d;
+  if (!RunWithHeartbeat<DelaunayResult>(
+        [frame, o, minAngle, planar]() { return planar ? RefineQuality2D(frame, minAngle) : Tetrahedralize(frame, o); },
+        progress, d))
+  {
+    result.Aborted = true;
+    return false;
+  }
+  if (!d.Error.empty() || d.Points.size() < frame.size())
+  {
+    result.Error = "quality refinement failed: " + d.Error;
+    return false;
+  }
+  result.AddedNodes = static_cast<std::int64_t>(d.Points.size() - frame.size());
+  std::vector<V3> index = s.Points;
+  for (size_t i = frame.size(); i < d.Points.size(); ++i)
+  {
+    index.push_back(g.FrameToIndex(d.Points[i]));
+  }
+  SimplexMesh refined(g, std::move(index), std::move(d.Cells), vpc);
+  refined.OrientPositively();
+  std::vector<std::uint8_t> fixedAll(fixed);
+  fixedAll.resize(refined.NumberOfPoints(), 0);
+  Smoother r(refined, FreeAxes(refined, fixedAll));
+  s = std::move(r);
+  return true;
+}
+} // namespace
+
 ImageMeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, const float* values,
   const ImageMeshSmoothingParameters& p, const ParallelFor& parallel, const ProgressFunction& progress)
 {
@@ -712,200 +975,48 @@ ImageMeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vec
   auto t0 = Clock::now();
   const ImageGeometry& g = mesh.Geometry();
   const int vpc = mesh.VerticesPerCell();
-  const std::int64_t n = mesh.NumberOfPoints();
-  // The smoothed image: its gradient magnitude weighs the density, its gradient direction is the
-  // normal along which fixed nodes may not slide.
+  // 1-2. The feature images; the free nodes, and the normals of fixed nodes that may slide.
+  FeatureImages images;
+  if (!MakeFeatureImages(values, g, p, parallel, progress, images))
+  {
+    result.Aborted = true;
+    return result;
+  }
   const bool slide = p.FixedNodeSlack > 0.0;
-  std::vector<float> smoothed, gradient;
-  double meanGradient = 0.0;
-  if ((p.FeatureWeight != 0.0 || slide) && p.Iterations > 0)
-  {
-    AssignFresh(smoothed, static_cast<size_t>(g.Size()));
-    GaussianSmooth(values, smoothed.data(), g, p.Sigma, parallel);
-    if (!progress(0.0))
-    {
-      result.Aborted = true;
-      return result;
-    }
-  }
-  if (p.FeatureWeight != 0.0 && p.Iterations > 0)
-  {
-    AssignFresh(gradient, smoothed.size());
-    GradientMagnitude(smoothed.data(), g, gradient.data(), parallel);
-    meanGradient = std::accumulate(gradient.begin(), gradient.end(), 0.0) / static_cast<double>(gradient.size());
-  }
   const std::vector<std::uint8_t> freeAxes = FreeAxes(mesh, fixed, slide);
   Smoother s(mesh, freeAxes);
-  if (slide && !smoothed.empty())
+  if (slide && !images.Smoothed.empty())
   {
-    // Voxels to frame units: the finest spacing of the image's axes.
-    double finest = std::min(std::fabs(g.Spacing[0]), std::fabs(g.Spacing[1]));
-    finest = g.Is2D() ? finest : std::min(finest, std::fabs(g.Spacing[2]));
-    s.Slack = p.FixedNodeSlack * finest;
-    s.Normal.assign(n, V3{ { 0, 0, 0 } });
-    for (std::int64_t v = 0; v < n; ++v)
-    {
-      if (v >= static_cast<std::int64_t>(fixed.size()) || !fixed[v] || !freeAxes[v])
-      {
-        continue;
-      }
-      // Central differences of the smoothed image at the node, per frame unit.
-      V3 normal = { { 0, 0, 0 } };
-      for (int a = 0; a < vpc - 1; ++a)
-      {
-        double lo[3] = { s.Anchor[v][0], s.Anchor[v][1], s.Anchor[v][2] }, hi[3] = { lo[0], lo[1], lo[2] };
-        lo[a] -= 0.5;
-        hi[a] += 0.5;
-        normal[a] = (InterpolateAt(smoothed.data(), g, hi) - InterpolateAt(smoothed.data(), g, lo)) / std::fabs(g.Spacing[a]);
-      }
-      const double length = std::sqrt(Dot(normal, normal));
-      if (length > 0.0)
-      {
-        s.Normal[v] = { { normal[0] / length, normal[1] / length, normal[2] / length } };
-      }
-      else
-      {
-        s.Free[v] = 0; // no edge direction: stays fixed
-      }
-    }
+    SetSlideNormals(s, fixed, freeAxes, images.Smoothed, g, p.FixedNodeSlack);
   }
   // Only the gradient magnitude is read from here on: 4 bytes per voxel less while the mesher runs.
-  std::vector<float>().swap(smoothed);
+  std::vector<float>().swap(images.Smoothed);
   const int sweeps = std::max(0, p.Iterations);
   const bool perturb = vpc == 4 && p.SliverRemoval && sweeps > 0;
   // Progress: sweeps, then refinement, then slivers.
   const bool refine = p.QualityRefinement && sweeps > 0;
   const double sweepShare = refine ? 0.6 : (perturb ? 0.8 : 1.0);
   const double refineEnd = perturb ? 0.8 : 1.0;
-  std::vector<double> elementDensity;
+  // 3. The sweeps, each followed by the Delaunay property's restoration.
   std::vector<std::int64_t> neighbours = vpc == 3 && p.Flips && sweeps > 0 ? TriangleNeighbours(mesh) : std::vector<std::int64_t>();
-  std::vector<std::uint8_t> moved(n);
+  std::vector<std::uint8_t> moved(mesh.NumberOfPoints());
   for (int it = 0; it < sweeps; ++it)
   {
-    const CompressedRows& stars = s.Topology.Stars();
-    // An element's density is computed when a node first needs it in this sweep.
-    elementDensity.assign(s.Topology.NumberOfElements(), -1.0);
-    std::fill(moved.begin(), moved.end(), 0);
-    // Multicolour Gauss-Seidel: nodes of one colour share no element, so they move at once (any
-    // thread count gives the same result); colours greedily in node order, classes in colour order.
-    std::vector<int> colour(n, -1);
-    std::vector<int> lastSeen;
-    int colours = 0;
-    for (std::int64_t v = 0; v < n; ++v)
+    if (!Sweep(s, images, p, parallel, SubProgress(progress, sweepShare * it / sweeps, sweepShare * (it + 1) / sweeps), moved))
     {
-      if (!s.Free[v] || stars.Size(v) == 0)
-      {
-        continue;
-      }
-      // Neighbours through the star (cheaper than building the vertex-neighbour rows).
-      for (const std::int64_t* e = stars.Begin(v); e != stars.End(v); ++e)
-      {
-        const std::int64_t* cell = s.Topology.Cell(*e);
-        for (int k = 0; k < vpc; ++k)
-        {
-          if (colour[cell[k]] >= 0)
-          {
-            lastSeen[colour[cell[k]]] = static_cast<int>(v);
-          }
-        }
-      }
-      int c = 0;
-      while (c < colours && lastSeen[c] == v)
-      {
-        ++c;
-      }
-      if (c == colours)
-      {
-        ++colours;
-        lastSeen.push_back(-1);
-      }
-      colour[v] = c;
-    }
-    std::vector<std::int64_t> classStart(colours + 1, 0), byColour;
-    for (std::int64_t v = 0; v < n; ++v)
-    {
-      classStart[colour[v] + 1] += colour[v] >= 0 ? 1 : 0;
-    }
-    std::partial_sum(classStart.begin(), classStart.end(), classStart.begin());
-    byColour.resize(classStart[colours]);
-    {
-      std::vector<std::int64_t> fill(classStart.begin(), classStart.end() - 1);
-      for (std::int64_t v = 0; v < n; ++v)
-      {
-        if (colour[v] >= 0)
-        {
-          byColour[fill[colour[v]]++] = v;
-        }
-      }
-    }
-    s.Score.assign(s.Topology.NumberOfElements(), Stale);
-    for (int c = 0; c < colours; ++c)
-    {
-      if (!progress(sweepShare * (it + 0.9 * c / static_cast<double>(colours)) / sweeps))
-      {
-        result.Aborted = true;
-        return result;
-      }
-      parallel(classStart[c + 1] - classStart[c], 256, [&](std::int64_t b, std::int64_t e) {
-        std::vector<double> density;
-        for (std::int64_t i = classStart[c] + b; i < classStart[c] + e; ++i)
-        {
-          const std::int64_t v = byColour[i];
-          const std::int64_t* star = stars.Begin(v);
-          const std::int64_t size = stars.Size(v);
-          density.resize(size);
-          for (std::int64_t k = 0; k < size; ++k)
-          {
-            double& rho = elementDensity[star[k]];
-            if (rho < 0.0)
-            {
-              rho = gradient.empty() ? 1.0 : ElementDensity(s.Topology, s.Points, star[k], gradient.data(), meanGradient, p.FeatureWeight);
-            }
-            density[k] = rho;
-          }
-          const V3 target = SmoothingTarget(s.Topology, s.Points, star, size, density.data(), p.Method);
-          if (std::isfinite(target[0]) && s.TryMove(v, target, star, size))
-          {
-            moved[v] = 1;
-          }
-        }
-      });
+      result.Aborted = true;
+      return result;
     }
     result.Moves += std::count(moved.begin(), moved.end(), 1);
     // 3D refinement re-tetrahedralises the nodes itself: the last sweep need not.
     const bool refinedNext = vpc == 4 && p.QualityRefinement && it + 1 == sweeps;
     if (p.Flips && !refinedNext)
     {
-      std::vector<std::int64_t> cells = s.Topology.Cells();
-      if (vpc == 3)
+      const double at = sweepShare * (it + 0.95) / sweeps;
+      if (!RestoreDelaunay(s, moved, neighbours, [&](double) { return progress(at); }, result.Flips, result.Aborted, result.Error))
       {
-        result.Flips += DelaunayFlips(g, s.Points, moved, cells, neighbours);
+        return result;
       }
-      else
-      {
-        // Re-tetrahedralise the moved nodes (CGAL; the same ids, so node arrays still apply).
-        std::vector<V3> frame(s.Points.size());
-        std::transform(s.Points.begin(), s.Points.end(), frame.begin(), [&](const V3& q) { return g.IndexToFrame(q); });
-        DelaunayImageMeshParameters o;
-        o.Backend = DelaunayBackend::CGAL;
-        // CGAL has no progress or abort of its own: it runs beside a heartbeat.
-        DelaunayResult d;
-        const double at = sweepShare * (it + 0.95) / sweeps;
-        if (!RunWithHeartbeat<DelaunayResult>([frame, o]() { return Tetrahedralize(frame, o); },
-              [&](double) { return progress(at); }, d))
-        {
-          result.Aborted = true;
-          return result;
-        }
-        if (!d.Error.empty() || d.Points.size() != frame.size())
-        {
-          result.Error = "re-tetrahedralising the moved nodes failed: " + d.Error;
-          return result;
-        }
-        cells = std::move(d.Cells);
-      }
-      s.Topology = SimplexMesh(g, s.Points, std::move(cells), vpc);
-      // Positive orientation in frame coordinates is positive in index space (positive scales).
     }
     else
     {
@@ -913,52 +1024,16 @@ ImageMeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vec
     }
     result.IterationsRun = it + 1;
   }
-  std::vector<float>().swap(gradient);
+  std::vector<float>().swap(images.Gradient);
   result.SweepSeconds = since(t0);
+  // 4. Quality refinement.
   t0 = Clock::now();
-  if (refine)
+  if (refine && !RefineQuality(s, fixed, p, SubProgress(progress, sweepShare, refineEnd), result))
   {
-    if (vpc == 4)
-    {
-      result.SnappedNodes = SnapNodesToBox(g, s.Points);
-    }
-    std::vector<V3> frame(s.Points.size());
-    std::transform(s.Points.begin(), s.Points.end(), frame.begin(), [&](const V3& q) { return g.IndexToFrame(q); });
-    DelaunayImageMeshParameters o;
-    o.QualityRefinement = true;
-    o.MinDihedralAngle = p.MinDihedralAngle;
-    o.RadiusEdgeRatio = p.RadiusEdgeRatio;
-    o.PreserveBoundary = true;
-    const double minAngle = p.MinAngle;
-    const bool planar = vpc == 3;
-    // TetGen and CGAL's mesher have no progress or abort of their own: they run beside a heartbeat.
-    DelaunayResult d;
-    if (!RunWithHeartbeat<DelaunayResult>(
-          [frame, o, minAngle, planar]() { return planar ? RefineQuality2D(frame, minAngle) : Tetrahedralize(frame, o); },
-          SubProgress(progress, sweepShare, refineEnd), d))
-    {
-      result.Aborted = true;
-      return result;
-    }
-    if (!d.Error.empty() || d.Points.size() < frame.size())
-    {
-      result.Error = "quality refinement failed: " + d.Error;
-      return result;
-    }
-    result.AddedNodes = static_cast<std::int64_t>(d.Points.size() - frame.size());
-    std::vector<V3> index = s.Points;
-    for (size_t i = frame.size(); i < d.Points.size(); ++i)
-    {
-      index.push_back(g.FrameToIndex(d.Points[i]));
-    }
-    SimplexMesh refined(g, std::move(index), std::move(d.Cells), vpc);
-    refined.OrientPositively();
-    std::vector<std::uint8_t> fixedAll(fixed);
-    fixedAll.resize(refined.NumberOfPoints(), 0);
-    Smoother r(refined, FreeAxes(refined, fixedAll));
-    s = std::move(r);
+    return result;
   }
   result.RefinementSeconds = since(t0);
+  // 5. Sliver perturbation.
   t0 = Clock::now();
   if (perturb)
   {
