@@ -457,53 +457,22 @@ std::string ValidateParameters(const SegmentationSurfaceSmoothingParameters& p)
   return std::string();
 }
 
-SegmentationSurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const std::vector<std::uint8_t>& label,
-  const SegmentationSurfaceSmoothingParameters& p, const ParallelFor& parallel, const ProgressFunction& progress)
+namespace
 {
-  SegmentationSurfaceSmoothingResult r;
-  r.Error = ValidateParameters(p);
-  const std::int64_t nElements = mesh.NumberOfElements();
-  if (r.Error.empty() && static_cast<std::int64_t>(label.size()) != nElements)
-  {
-    r.Error = "there must be one label per element.";
-  }
-  if (!r.Error.empty())
-  {
-    return r;
-  }
-  auto start = Clock::now();
-  const int vpc = mesh.VerticesPerCell();
-  const int faceSize = vpc - 1;
-  r.Points = mesh.Points();
-  r.Faces = LabelBoundaryFaces(mesh, label, &r.InterfaceFaces);
-  std::vector<V3> frame = mesh.FramePoints();
-  // Several labels: interfaces between objects are inside the labelled region, so its measure is
-  // summed over elements rather than enclosed by the boundary.
-  const bool several = std::any_of(label.begin(), label.end(), [](std::uint8_t l) { return l > 1; });
-  auto measure = [&](const std::vector<V3>& points) {
-    return several ? LabelledMeasure(mesh, points, label) : EnclosedMeasure(points, r.Faces, faceSize);
-  };
-  r.ObjectMeasureBefore = measure(frame);
-  r.Shortfall.assign(frame.size(), 0.0);
-  if (r.Faces.empty())
-  {
-    r.ObjectMeasureAfter = r.ObjectMeasureBefore;
-    r.BoundaryPoints = r.Points;
-    r.SurfaceSeconds = Seconds(start);
-    return r;
-  }
-
-  // The boundary's targets.
-  const Boundary b = BoundaryGraph(mesh.NumberOfPoints(), r.Faces, faceSize, r.InterfaceFaces);
+// Step 1: the boundary nodes' smoothed positions (frame units): Laplacian or Taubin passes, each
+// node along its free axes and over its rows (a junction curve's node along the curve, a node on
+// the image box over its interface neighbours only); pinched and junction points stay. Counts the
+// pinched nodes into r.
+std::vector<V3> SmoothedBoundary(const SimplexMesh& mesh, const std::vector<std::uint8_t>& label, const Boundary& b,
+  const std::vector<V3>& frame, const std::vector<std::uint8_t>& freeAxes, bool several,
+  const SegmentationSurfaceSmoothingParameters& p, const ParallelFor& parallel, SegmentationSurfaceSmoothingResult& r)
+{
   const std::int64_t n = static_cast<std::int64_t>(b.Node.size());
-  r.BoundaryNodes = n;
-  r.NonManifoldEdges = b.NonManifoldEdges;
-  const std::vector<std::uint8_t> freeAxes = FreeAxes(mesh, std::vector<std::uint8_t>());
   std::vector<std::uint8_t> axes(n);
   std::vector<V3> x(n), next(n);
   // A node where the interface meets the image box averages its interface neighbours only: the
   // object's faces on the box would pull the rim inwards (a free-boundary condition instead).
-  const std::uint8_t allAxes = faceSize == 2 ? 3 : 7;
+  const std::uint8_t allAxes = mesh.VerticesPerCell() == 3 ? 3 : 7;
   std::vector<const CompressedRows*> rows(n, &b.Neighbours);
   const Junctions junctions = several ? JunctionGraph(mesh, label, b, r.InterfaceFaces) : Junctions();
   for (std::int64_t i = 0; i < n; ++i)
@@ -545,6 +514,215 @@ SegmentationSurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& 
       std::swap(x, next);
     }
   }
+  return x;
+}
+
+// Step 2: the band the volume mesh relaxes in: rings of nodes around the boundary (ring 0 the
+// boundary, each next ring one pass over the elements), the elements they touch, and the band
+// nodes' stars and neighbours.
+struct Band
+{
+  std::vector<int> Ring;                        // per mesh node; -1 outside the band
+  std::vector<std::vector<std::int64_t>> Rings; // each ring's nodes, sorted
+  std::vector<std::int64_t> Elements;
+  CompressedRows Stars, Neighbours;
+};
+Band BoundaryBand(const SimplexMesh& mesh, const std::vector<std::int64_t>& boundaryNodes, int relaxationRings)
+{
+  const std::int64_t nPoints = mesh.NumberOfPoints(), nElements = mesh.NumberOfElements();
+  const int vpc = mesh.VerticesPerCell();
+  Band band;
+  std::vector<int>& ring = band.Ring;
+  ring.assign(nPoints, -1);
+  for (const std::int64_t v : boundaryNodes)
+  {
+    ring[v] = 0;
+  }
+  band.Rings.push_back(boundaryNodes);
+  std::sort(band.Rings[0].begin(), band.Rings[0].end());
+  for (int k = 1; k <= relaxationRings; ++k)
+  {
+    band.Rings.emplace_back();
+    for (std::int64_t e = 0; e < nElements; ++e)
+    {
+      const std::int64_t* c = mesh.Cell(e);
+      if (std::any_of(c, c + vpc, [&](std::int64_t v) { return ring[v] == k - 1; }))
+      {
+        for (int j = 0; j < vpc; ++j)
+        {
+          if (ring[c[j]] < 0)
+          {
+            ring[c[j]] = k;
+            band.Rings[k].push_back(c[j]);
+          }
+        }
+      }
+    }
+    std::sort(band.Rings[k].begin(), band.Rings[k].end());
+  }
+  std::vector<std::pair<std::int64_t, std::int64_t>> starPairs, neighbourPairs;
+  for (std::int64_t e = 0; e < nElements; ++e)
+  {
+    const std::int64_t* c = mesh.Cell(e);
+    if (std::none_of(c, c + vpc, [&](std::int64_t v) { return ring[v] >= 0; }))
+    {
+      continue;
+    }
+    band.Elements.push_back(e);
+    for (int j = 0; j < vpc; ++j)
+    {
+      if (ring[c[j]] >= 0)
+      {
+        starPairs.emplace_back(c[j], e);
+        for (int l = 0; l < vpc; ++l)
+        {
+          if (l != j)
+          {
+            neighbourPairs.emplace_back(c[j], c[l]);
+          }
+        }
+      }
+    }
+  }
+  band.Stars = RowsFromPairs(nPoints, starPairs);
+  band.Neighbours = RowsFromPairs(nPoints, neighbourPairs);
+  return band;
+}
+
+// Step 3: each band node's target: the boundary's smoothed positions, and for each ring the mean of
+// the inner ring's moves, fading linearly to zero past the last ring.
+std::vector<V3> BandTargets(const Band& band, const std::vector<std::int64_t>& boundaryNodes, const std::vector<V3>& x,
+  const std::vector<V3>& frame, const std::vector<std::uint8_t>& freeAxes, int relaxationRings)
+{
+  const std::int64_t nPoints = static_cast<std::int64_t>(frame.size());
+  std::vector<V3> move(nPoints, V3{ { 0, 0, 0 } });
+  for (std::size_t i = 0; i < boundaryNodes.size(); ++i)
+  {
+    move[boundaryNodes[i]] = Sub(x[i], frame[boundaryNodes[i]]);
+  }
+  for (int k = 1; k <= relaxationRings; ++k)
+  {
+    const double share = 1.0 - 1.0 / (relaxationRings + 2 - k);
+    for (const std::int64_t v : band.Rings[k])
+    {
+      V3 mean = { { 0, 0, 0 } };
+      int count = 0;
+      for (const std::int64_t* w = band.Neighbours.Begin(v); w != band.Neighbours.End(v); ++w)
+      {
+        if (band.Ring[*w] == k - 1)
+        {
+          for (int a = 0; a < 3; ++a)
+          {
+            mean[a] += move[*w][a];
+          }
+          ++count;
+        }
+      }
+      for (int a = 0; a < 3; ++a)
+      {
+        mean[a] *= share / count;
+      }
+      move[v] = Masked(V3{ { 0, 0, 0 } }, mean, freeAxes[v]);
+    }
+  }
+  std::vector<V3> target(nPoints);
+  for (std::int64_t v = 0; v < nPoints; ++v)
+  {
+    target[v] = band.Ring[v] < 0 ? frame[v] : V3{ { frame[v][0] + move[v][0], frame[v][1] + move[v][1], frame[v][2] + move[v][2] } };
+  }
+  return target;
+}
+
+// Step 5: boundary nodes that stopped short of their targets x: their neighbours off the boundary
+// make room (moves that raise their star's quality), then they try again; at most three rounds.
+void MakeRoom(VolumeMover& mover, const Band& band, const std::vector<std::int64_t>& boundaryNodes, const std::vector<V3>& x,
+  std::vector<V3>& frame, const std::vector<std::uint8_t>& freeAxes, double tolerance)
+{
+  const std::int64_t n = static_cast<std::int64_t>(boundaryNodes.size());
+  auto shortfall = [&](std::int64_t i) { return Norm(Sub(frame[boundaryNodes[i]], x[i])); };
+  for (int round = 0; round < 3; ++round)
+  {
+    std::vector<std::int64_t> stuck;
+    for (std::int64_t i = 0; i < n; ++i)
+    {
+      if (shortfall(i) > tolerance)
+      {
+        stuck.push_back(i);
+      }
+    }
+    if (stuck.empty())
+    {
+      break;
+    }
+    std::int64_t progressMade = 0;
+    for (const std::int64_t i : stuck)
+    {
+      const std::int64_t v = boundaryNodes[i];
+      for (const std::int64_t* w = band.Neighbours.Begin(v); w != band.Neighbours.End(v); ++w)
+      {
+        if (band.Ring[*w] > 0 && freeAxes[*w])
+        {
+          mover.TryMove(*w, Masked(frame[*w], NeighbourMean(band.Neighbours, *w, frame), freeAxes[*w]), true);
+        }
+      }
+      const double before = shortfall(i);
+      if (mover.TryMove(v, x[i]) || mover.TryMove(v, Lerp(frame[v], x[i], 0.5)) ||
+        mover.TryMove(v, Lerp(frame[v], x[i], 0.25)))
+      {
+        progressMade += shortfall(i) < before;
+      }
+    }
+    if (!progressMade)
+    {
+      break;
+    }
+  }
+}
+} // namespace
+
+SegmentationSurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& mesh, const std::vector<std::uint8_t>& label,
+  const SegmentationSurfaceSmoothingParameters& p, const ParallelFor& parallel, const ProgressFunction& progress)
+{
+  SegmentationSurfaceSmoothingResult r;
+  r.Error = ValidateParameters(p);
+  const std::int64_t nElements = mesh.NumberOfElements();
+  if (r.Error.empty() && static_cast<std::int64_t>(label.size()) != nElements)
+  {
+    r.Error = "there must be one label per element.";
+  }
+  if (!r.Error.empty())
+  {
+    return r;
+  }
+  auto start = Clock::now();
+  const int vpc = mesh.VerticesPerCell();
+  const int faceSize = vpc - 1;
+  r.Points = mesh.Points();
+  r.Faces = LabelBoundaryFaces(mesh, label, &r.InterfaceFaces);
+  std::vector<V3> frame = mesh.FramePoints();
+  // Several labels: interfaces between objects are inside the labelled region, so its measure is
+  // summed over elements rather than enclosed by the boundary.
+  const bool several = std::any_of(label.begin(), label.end(), [](std::uint8_t l) { return l > 1; });
+  auto measure = [&](const std::vector<V3>& points) {
+    return several ? LabelledMeasure(mesh, points, label) : EnclosedMeasure(points, r.Faces, faceSize);
+  };
+  r.ObjectMeasureBefore = measure(frame);
+  r.Shortfall.assign(frame.size(), 0.0);
+  if (r.Faces.empty())
+  {
+    r.ObjectMeasureAfter = r.ObjectMeasureBefore;
+    r.BoundaryPoints = r.Points;
+    r.SurfaceSeconds = Seconds(start);
+    return r;
+  }
+
+  // 1. The boundary's targets.
+  const Boundary b = BoundaryGraph(mesh.NumberOfPoints(), r.Faces, faceSize, r.InterfaceFaces);
+  const std::int64_t n = static_cast<std::int64_t>(b.Node.size());
+  r.BoundaryNodes = n;
+  r.NonManifoldEdges = b.NonManifoldEdges;
+  const std::vector<std::uint8_t> freeAxes = FreeAxes(mesh, std::vector<std::uint8_t>());
+  const std::vector<V3> x = SmoothedBoundary(mesh, label, b, frame, freeAxes, several, p, parallel, r);
   r.SurfaceSeconds = Seconds(start);
   if (!progress(0.2))
   {
@@ -572,124 +750,32 @@ SegmentationSurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& 
     return r;
   }
 
-  // Rings around the boundary (passes over the elements), the elements they touch (the band), and
-  // the band nodes' stars and neighbours.
+  // 2-3. The band around the boundary and its nodes' targets.
   const std::int64_t nPoints = mesh.NumberOfPoints();
-  std::vector<int> ring(nPoints, -1);
-  std::vector<std::vector<std::int64_t>> rings(1);
-  for (std::int64_t i = 0; i < n; ++i)
-  {
-    ring[b.Node[i]] = 0;
-  }
-  rings[0] = b.Node;
-  std::sort(rings[0].begin(), rings[0].end());
-  for (int k = 1; k <= p.RelaxationRings; ++k)
-  {
-    rings.emplace_back();
-    for (std::int64_t e = 0; e < nElements; ++e)
-    {
-      const std::int64_t* c = mesh.Cell(e);
-      if (std::any_of(c, c + vpc, [&](std::int64_t v) { return ring[v] == k - 1; }))
-      {
-        for (int j = 0; j < vpc; ++j)
-        {
-          if (ring[c[j]] < 0)
-          {
-            ring[c[j]] = k;
-            rings[k].push_back(c[j]);
-          }
-        }
-      }
-    }
-    std::sort(rings[k].begin(), rings[k].end());
-  }
-  std::vector<std::pair<std::int64_t, std::int64_t>> starPairs, neighbourPairs;
-  std::vector<std::int64_t> band;
-  for (std::int64_t e = 0; e < nElements; ++e)
-  {
-    const std::int64_t* c = mesh.Cell(e);
-    if (std::none_of(c, c + vpc, [&](std::int64_t v) { return ring[v] >= 0; }))
-    {
-      continue;
-    }
-    band.push_back(e);
-    for (int j = 0; j < vpc; ++j)
-    {
-      if (ring[c[j]] >= 0)
-      {
-        starPairs.emplace_back(c[j], e);
-        for (int l = 0; l < vpc; ++l)
-        {
-          if (l != j)
-          {
-            neighbourPairs.emplace_back(c[j], c[l]);
-          }
-        }
-      }
-    }
-  }
-  const CompressedRows stars = RowsFromPairs(nPoints, starPairs);
-  const CompressedRows neighbours = RowsFromPairs(nPoints, neighbourPairs);
+  const Band band = BoundaryBand(mesh, b.Node, p.RelaxationRings);
   if (!progress(0.3))
   {
     r.Aborted = true;
     return r;
   }
+  const std::vector<V3> target = BandTargets(band, b.Node, x, frame, freeAxes, p.RelaxationRings);
 
-  // Each ring's share of the move: the mean of the inner ring's, fading linearly to zero past the
-  // last ring.
-  std::vector<V3> move(nPoints, V3{ { 0, 0, 0 } });
-  for (std::int64_t i = 0; i < n; ++i)
-  {
-    move[b.Node[i]] = Sub(x[i], frame[b.Node[i]]);
-  }
-  for (int k = 1; k <= p.RelaxationRings; ++k)
-  {
-    const double share = 1.0 - 1.0 / (p.RelaxationRings + 2 - k);
-    for (const std::int64_t v : rings[k])
-    {
-      V3 mean = { { 0, 0, 0 } };
-      int count = 0;
-      for (const std::int64_t* w = neighbours.Begin(v); w != neighbours.End(v); ++w)
-      {
-        if (ring[*w] == k - 1)
-        {
-          for (int a = 0; a < 3; ++a)
-          {
-            mean[a] += move[*w][a];
-          }
-          ++count;
-        }
-      }
-      for (int a = 0; a < 3; ++a)
-      {
-        mean[a] *= share / count;
-      }
-      move[v] = Masked(V3{ { 0, 0, 0 } }, mean, freeAxes[v]);
-    }
-  }
-
-  VolumeMover mover{ mesh, stars, frame, std::vector<double>(nElements, 1.0), vpc };
+  // 4. Passes over the boundary, then ring by ring: a node moves the whole way when its star allows
+  // it, else to the pass's step along its move, else half-way there; no element falls below its
+  // angle floor (its own angle when lower, a hair below, so that rounding never blocks a move that
+  // keeps it).
+  VolumeMover mover{ mesh, band.Stars, frame, std::vector<double>(nElements, 1.0), vpc };
   const double cosFloor = std::cos((faceSize == 2 ? p.MinAngle : p.MinDihedralAngle) * 3.14159265358979323846 / 180.0);
-  for (const std::int64_t e : band)
+  for (const std::int64_t e : band.Elements)
   {
-    // The element's own angle when lower (a hair below, so that rounding never blocks a move that
-    // keeps it).
     mover.CosFloor[e] = std::max(mover.MaxCosine(e) + 1e-12, cosFloor);
   }
   const std::vector<V3> start0 = frame;
-  std::vector<V3> target(nPoints);
-  for (std::int64_t v = 0; v < nPoints; ++v)
-  {
-    target[v] = ring[v] < 0 ? frame[v] : V3{ { frame[v][0] + move[v][0], frame[v][1] + move[v][1], frame[v][2] + move[v][2] } };
-  }
-  // Passes over the boundary, then ring by ring: a node moves the whole way when its star allows
-  // it, else to the pass's step along its move, else half-way there.
   const int steps = 4;
   for (int s = 1; s <= steps; ++s)
   {
     const double t = static_cast<double>(s) / steps;
-    for (const auto& nodes : rings)
+    for (const auto& nodes : band.Rings)
     {
       for (const std::int64_t v : nodes)
       {
@@ -710,61 +796,24 @@ SegmentationSurfaceSmoothingResult SmoothSegmentationSurface(const SimplexMesh& 
       return r;
     }
   }
-  // Boundary nodes that stopped short: their neighbours off the boundary make room (moves that raise
-  // their star's quality), then they try again.
-  auto shortfall = [&](std::int64_t i) { return Norm(Sub(frame[b.Node[i]], x[i])); };
+  // 5. Boundary nodes that stopped short.
   const double tolerance = 1e-9 * std::max({ std::fabs(g.Spacing[0]), std::fabs(g.Spacing[1]), std::fabs(g.Spacing[2]) });
-  for (int round = 0; round < 3; ++round)
-  {
-    std::vector<std::int64_t> stuck;
-    for (std::int64_t i = 0; i < n; ++i)
-    {
-      if (shortfall(i) > tolerance)
-      {
-        stuck.push_back(i);
-      }
-    }
-    if (stuck.empty())
-    {
-      break;
-    }
-    std::int64_t progressMade = 0;
-    for (const std::int64_t i : stuck)
-    {
-      const std::int64_t v = b.Node[i];
-      for (const std::int64_t* w = neighbours.Begin(v); w != neighbours.End(v); ++w)
-      {
-        if (ring[*w] > 0 && freeAxes[*w])
-        {
-          mover.TryMove(*w, Masked(frame[*w], NeighbourMean(neighbours, *w, frame), freeAxes[*w]), true);
-        }
-      }
-      const double before = shortfall(i);
-      if (mover.TryMove(v, x[i]) || mover.TryMove(v, Lerp(frame[v], x[i], 0.5)) ||
-        mover.TryMove(v, Lerp(frame[v], x[i], 0.25)))
-      {
-        progressMade += shortfall(i) < before;
-      }
-    }
-    if (!progressMade)
-    {
-      break;
-    }
-  }
+  MakeRoom(mover, band, b.Node, x, frame, freeAxes, tolerance);
   if (!progress(0.9))
   {
     r.Aborted = true;
     return r;
   }
+  // 6. The moved points and what the move reached.
   for (std::int64_t v = 0; v < nPoints; ++v)
   {
-    r.RelaxedNodes += ring[v] > 0 && frame[v] != start0[v];
+    r.RelaxedNodes += band.Ring[v] > 0 && frame[v] != start0[v];
     r.Points[v] = frame[v] == start0[v] ? mesh.Points()[v] : toIndex(v, frame[v]);
   }
   double total = 0.0, missed = 0.0;
   for (std::int64_t i = 0; i < n; ++i)
   {
-    const double d = shortfall(i);
+    const double d = Norm(Sub(frame[b.Node[i]], x[i]));
     total += Norm(Sub(x[i], start0[b.Node[i]]));
     missed += d;
     r.Shortfall[b.Node[i]] = d;
