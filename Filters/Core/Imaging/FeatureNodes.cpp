@@ -158,12 +158,196 @@ std::string ValidateParameters(const FeatureNodeParameters& p)
   return std::string();
 }
 
+namespace
+{
+// The noise's level (NoiseFloor), and the floors it gives the gradient (Canny's thresholds) and
+// the Hessian diagonal (the feature map), in the units of the image as read.
+struct NoiseFloors
+{
+  double Sigma = 0.0, Low = 0.0, High = 0.0, Feature = 0.0;
+};
+NoiseFloors EstimateNoiseFloors(const float* image, const ImageGeometry& g, const FeatureNodeParameters& p,
+  const ParallelFor& parallel)
+{
+  NoiseFloors floors;
+  if (p.NoiseFloor)
+  {
+    floors.Sigma = EstimateNoiseSigma(image, g, parallel);
+    const double gradient = floors.Sigma * FilteredNoiseDeviation(g.Dimension(), p.GaussianSigma, { 0.5, 0.0, -0.5 });
+    floors.Low = p.NoiseLowFactor * gradient;
+    floors.High = p.NoiseHighFactor * gradient;
+    floors.Feature =
+      p.NoiseFeatureFactor * floors.Sigma * FilteredNoiseDeviation(g.Dimension(), p.HessianSigma, { 1.0, -2.0, 1.0 });
+  }
+  return floors;
+}
+
+// The edge voxels of `edgeMap` in voxel order: per-block lists joined in block order, the same
+// order whatever the thread count.
+std::vector<std::int64_t> EdgeVoxels(const std::vector<std::uint8_t>& edgeMap, const ParallelFor& parallel)
+{
+  const std::int64_t n = static_cast<std::int64_t>(edgeMap.size());
+  const std::int64_t block = (n + ReductionBlocks - 1) / ReductionBlocks;
+  std::vector<std::vector<std::int64_t>> found(ReductionBlocks);
+  parallel(ReductionBlocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+    for (std::int64_t b = b0; b < b1; ++b)
+    {
+      for (std::int64_t i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
+      {
+        if (edgeMap[i])
+        {
+          found[b].push_back(i);
+        }
+      }
+    }
+  });
+  std::size_t total = 0;
+  for (const auto& f : found)
+  {
+    total += f.size();
+  }
+  std::vector<std::int64_t> points;
+  points.reserve(total);
+  for (const auto& f : found)
+  {
+    points.insert(points.end(), f.begin(), f.end());
+  }
+  return points;
+}
+
+// The nodes as they are placed, one per voxel: the first kind to claim a voxel keeps it (boundary,
+// then Canny, halftone, uniform).
+class NodePlacer
+{
+public:
+  NodePlacer(const ImageGeometry& g, FeatureNodeResult& out)
+    : G(g)
+    , Out(out)
+  {
+    AssignFresh(this->Occupied, g.Size(), std::uint8_t(0));
+  }
+  void Add(int i, int j, int k, NodeType type, float radius)
+  {
+    const std::int64_t idx = this->G.Index(i, j, k);
+    if (this->Occupied[idx])
+    {
+      return;
+    }
+    this->Occupied[idx] = 1;
+    this->Out.Positions.push_back({ { i, j, k } });
+    this->Out.Type.push_back(type);
+    // Smoothing may slide boundary nodes along the box, but never moves a corner.
+    bool corner = true;
+    const int ijk[3] = { i, j, k };
+    for (int a = 0; a < this->G.Dimension(); ++a)
+    {
+      corner = corner && (ijk[a] == 0 || ijk[a] == this->G.Dims[a] - 1);
+    }
+    this->Out.Fixed.push_back(type == NodeType::Canny || (type == NodeType::Boundary && corner) ? 1 : 0);
+    this->Out.SampleRadius.push_back(radius);
+    this->Out.Counts[static_cast<int>(type)]++;
+  }
+  std::vector<std::uint8_t> Occupied;
+
+private:
+  const ImageGeometry& G;
+  FeatureNodeResult& Out;
+};
+
+// Seed-aware nodes: the distance from the edges sets how coarse the fill may be; a lattice point of
+// level l keeps every 2^l-th position (nested lattices, so the levels join without gaps). Level 0
+// everywhere without a distance.
+struct Coarsening
+{
+  const std::vector<float>& FromEdges;
+  const ImageGeometry& G;
+  int Levels, Spacing;
+  int operator()(int i, int j, int k) const
+  {
+    if (this->FromEdges.empty())
+    {
+      return 0;
+    }
+    const double d = this->FromEdges[this->G.Index(i, j, k)];
+    int l = 0;
+    while (l < this->Levels && d >= ((1 << (l + 2)) - 2) * static_cast<double>(this->Spacing))
+    {
+      ++l;
+    }
+    return l;
+  }
+  static bool OnLevel(int index, int last, int l) { return index == last || index % (1 << l) == 0; }
+};
+
+// Step 3: boundary nodes, corners always, evenly spaced along the border (2D) or on the box faces (3D).
+void PlaceBoundaryNodes(const ImageGeometry& g, int spacing, const Coarsening& level, NodePlacer& nodes)
+{
+  const std::vector<int> px = EvenPositions(g.Dims[0], spacing);
+  const std::vector<int> py = EvenPositions(g.Dims[1], spacing);
+  const std::vector<int> pz = EvenPositions(g.Dims[2], spacing);
+  const float r = 0.5f * spacing;
+  const int lx = g.Dims[0] - 1, ly = g.Dims[1] - 1, lz = g.Dims[2] - 1;
+  const int nx = static_cast<int>(px.size()), ny = static_cast<int>(py.size()), nz = static_cast<int>(pz.size());
+  for (int c = 0; c < nz; ++c)
+  {
+    for (int b = 0; b < ny; ++b)
+    {
+      for (int a = 0; a < nx; ++a)
+      {
+        const int i = px[a], j = py[b], k = pz[c];
+        const bool onFace = i == 0 || i == lx || j == 0 || j == ly || (!g.Is2D() && (k == 0 || k == lz));
+        if (!onFace)
+        {
+          continue;
+        }
+        const int l = level(i, j, k);
+        if (Coarsening::OnLevel(a, nx - 1, l) && Coarsening::OnLevel(b, ny - 1, l) && Coarsening::OnLevel(c, nz - 1, l))
+        {
+          nodes.Add(i, j, k, NodeType::Boundary, r);
+        }
+      }
+    }
+  }
+}
+
+// Step 5: uniform lattice points where no edge voxel and no node lies within the window (edge
+// voxels count as occupied from here, so none lands on one either).
+void PlaceUniformNodes(const ImageGeometry& g, int spacing, int h, const std::vector<std::uint8_t>& edgeMap,
+  const Coarsening& level, NodePlacer& nodes)
+{
+  for (std::int64_t i = 0; i < g.Size(); ++i)
+  {
+    nodes.Occupied[i] |= edgeMap[i];
+  }
+  const bool is2D = g.Is2D();
+  const int s = spacing;
+  const int start = s / 2;
+  for (int k = is2D ? 0 : start; k < g.Dims[2]; k += s)
+  {
+    for (int j = start; j < g.Dims[1]; j += s)
+    {
+      for (int i = start; i < g.Dims[0]; i += s)
+      {
+        const int m = 1 << level(i, j, k);
+        if (((i - start) / s) % m || ((j - start) / s) % m || (!is2D && ((k - start) / s) % m))
+        {
+          continue;
+        }
+        if (!AnyInBox(nodes.Occupied, g, i, j, k, h))
+        {
+          nodes.Add(i, j, k, NodeType::Uniform, 0.5f * s);
+        }
+      }
+    }
+  }
+}
+} // namespace
+
 FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* edgeInput, const ImageGeometry& g,
   const FeatureNodeParameters& p, const ParallelFor& parallel, const ProgressFunction& progress)
 {
   FeatureNodeResult out;
   const std::int64_t n = g.Size();
-  const bool is2D = g.Is2D();
   // Two volume-sized buffers, each used twice: (Canny-scale image, gradient magnitude), then
   // (feature map, Hessian-scale image). A fresh 36 MB buffer costs ~20 ms of page faults here,
   // and default-initialised storage skips a needless zero fill.
@@ -189,17 +373,8 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
     });
     image = rescaled.data();
   }
-  // The noise's level, and what it gives the gradient (Canny's scale) and the Hessian diagonal.
-  double lowFloor = 0.0, highFloor = 0.0, featureFloor = 0.0;
-  if (p.NoiseFloor)
-  {
-    const double sigma = EstimateNoiseSigma(image, g, parallel);
-    out.NoiseSigma = std::ldexp(sigma, exponent);
-    const double gradient = sigma * FilteredNoiseDeviation(g.Dimension(), p.GaussianSigma, { 0.5, 0.0, -0.5 });
-    lowFloor = p.NoiseLowFactor * gradient;
-    highFloor = p.NoiseHighFactor * gradient;
-    featureFloor = p.NoiseFeatureFactor * sigma * FilteredNoiseDeviation(g.Dimension(), p.HessianSigma, { 1.0, -2.0, 1.0 });
-  }
+  const NoiseFloors floors = EstimateNoiseFloors(image, g, p, parallel);
+  out.NoiseSigma = std::ldexp(floors.Sigma, exponent);
   GaussianSmooth(image, f, g, p.GaussianSigma, parallel);
   out.StepSeconds.emplace_back("gaussian", SecondsSince(t0));
   if (!progress(0.1))
@@ -217,8 +392,8 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
   if (seedAware)
   {
     const std::vector<float> fromMap = DistanceToMask(edgeInput, g, parallel);
-    allCanny = CannyEdges(f, g, p.LowThreshold, p.HighThreshold, p.MaximumPercentile, parallel,
-      &out.GradientMaximum, work, lowFloor, highFloor, p.GaussianSigma);
+    allCanny = CannyEdges(f, g, p.LowThreshold, p.HighThreshold, p.MaximumPercentile, parallel, &out.GradientMaximum, work,
+      floors.Low, floors.High, p.GaussianSigma);
     const float gate = static_cast<float>(p.EdgeGateRadius);
     out.EdgeMap.resize(n);
     for (std::int64_t i = 0; i < n; ++i)
@@ -236,8 +411,8 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
   }
   else
   {
-    out.EdgeMap = CannyEdges(f, g, p.LowThreshold, p.HighThreshold, p.MaximumPercentile, parallel,
-      &out.GradientMaximum, work, lowFloor, highFloor, p.GaussianSigma);
+    out.EdgeMap = CannyEdges(f, g, p.LowThreshold, p.HighThreshold, p.MaximumPercentile, parallel, &out.GradientMaximum,
+      work, floors.Low, floors.High, p.GaussianSigma);
   }
   out.StepSeconds.emplace_back("canny", SecondsSince(t0));
   if (!progress(0.3))
@@ -248,34 +423,7 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
 
   // 2. PCA-adaptive sampling of the edge points.
   t0 = Clock::now();
-  std::vector<std::int64_t> edgePoints;
-  {
-    // Per-block lists joined in block order: the same voxel order whatever the thread count.
-    const std::int64_t block = (n + ReductionBlocks - 1) / ReductionBlocks;
-    std::vector<std::vector<std::int64_t>> found(ReductionBlocks);
-    parallel(ReductionBlocks, 1, [&](std::int64_t b0, std::int64_t b1) {
-      for (std::int64_t b = b0; b < b1; ++b)
-      {
-        for (std::int64_t i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i)
-        {
-          if (out.EdgeMap[i])
-          {
-            found[b].push_back(i);
-          }
-        }
-      }
-    });
-    std::size_t total = 0;
-    for (const auto& f : found)
-    {
-      total += f.size();
-    }
-    edgePoints.reserve(total);
-    for (const auto& f : found)
-    {
-      edgePoints.insert(edgePoints.end(), f.begin(), f.end());
-    }
-  }
+  const std::vector<std::int64_t> edgePoints = EdgeVoxels(out.EdgeMap, parallel);
   out.EdgeVoxels = static_cast<std::int64_t>(edgePoints.size());
   const std::vector<std::uint8_t> radii = EdgeSampleRadii(edgePoints, out.EdgeMap, g, p, parallel);
   out.StepSeconds.emplace_back("pca", SecondsSince(t0));
@@ -288,87 +436,17 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
     return out;
   }
 
-  // Node occupancy, one node per voxel: boundary nodes claim first, then Canny, halftone, uniform.
-  std::vector<std::uint8_t> occupied;
-  AssignFresh(occupied, n, std::uint8_t(0));
-  auto add = [&](int i, int j, int k, NodeType type, float radius) {
-    const std::int64_t idx = g.Index(i, j, k);
-    if (occupied[idx])
-    {
-      return;
-    }
-    occupied[idx] = 1;
-    out.Positions.push_back({ { i, j, k } });
-    out.Type.push_back(type);
-    // Smoothing may slide boundary nodes along the box, but never moves a corner.
-    bool corner = true;
-    const int ijk[3] = { i, j, k };
-    for (int a = 0; a < g.Dimension(); ++a)
-    {
-      corner = corner && (ijk[a] == 0 || ijk[a] == g.Dims[a] - 1);
-    }
-    out.Fixed.push_back(type == NodeType::Canny || (type == NodeType::Boundary && corner) ? 1 : 0);
-    out.SampleRadius.push_back(radius);
-    out.Counts[static_cast<int>(type)]++;
-  };
-
-  // Seed-aware: the distance from the edges sets how coarse the fill may be; a lattice point of
-  // level l keeps every 2^l-th position (nested lattices, so the levels join without gaps).
-  std::vector<float> fromEdges;
-  if (seedAware)
-  {
-    fromEdges = DistanceToMask(out.EdgeMap.data(), g, parallel);
-  }
-  const auto level = [&](int i, int j, int k) {
-    if (fromEdges.empty())
-    {
-      return 0;
-    }
-    const double d = fromEdges[g.Index(i, j, k)];
-    int l = 0;
-    while (l < p.CoarseningLevels && d >= ((1 << (l + 2)) - 2) * static_cast<double>(p.UniformSpacing))
-    {
-      ++l;
-    }
-    return l;
-  };
-  const auto onLevel = [](int index, int last, int l) { return index == last || index % (1 << l) == 0; };
-
-  // 3. Boundary nodes: corners always, evenly spaced along the border (2D) or on the box faces (3D).
+  // 3. Boundary nodes claim first, then the thinned Canny points.
+  NodePlacer nodes(g, out);
+  const std::vector<float> fromEdges = seedAware ? DistanceToMask(out.EdgeMap.data(), g, parallel) : std::vector<float>();
+  const Coarsening level{ fromEdges, g, p.CoarseningLevels, p.UniformSpacing };
   t0 = Clock::now();
-  {
-    const std::vector<int> px = EvenPositions(g.Dims[0], p.BoundarySpacing);
-    const std::vector<int> py = EvenPositions(g.Dims[1], p.BoundarySpacing);
-    const std::vector<int> pz = EvenPositions(g.Dims[2], p.BoundarySpacing);
-    const float r = 0.5f * p.BoundarySpacing;
-    const int lx = g.Dims[0] - 1, ly = g.Dims[1] - 1, lz = g.Dims[2] - 1;
-    const int nx = static_cast<int>(px.size()), ny = static_cast<int>(py.size()), nz = static_cast<int>(pz.size());
-    for (int c = 0; c < nz; ++c)
-    {
-      for (int b = 0; b < ny; ++b)
-      {
-        for (int a = 0; a < nx; ++a)
-        {
-          const int i = px[a], j = py[b], k = pz[c];
-          const bool onFace = i == 0 || i == lx || j == 0 || j == ly || (!is2D && (k == 0 || k == lz));
-          if (!onFace)
-          {
-            continue;
-          }
-          const int l = level(i, j, k);
-          if (onLevel(a, nx - 1, l) && onLevel(b, ny - 1, l) && onLevel(c, nz - 1, l))
-          {
-            add(i, j, k, NodeType::Boundary, r);
-          }
-        }
-      }
-    }
-  }
+  PlaceBoundaryNodes(g, p.BoundarySpacing, level, nodes);
   for (std::int64_t t : kept)
   {
     int i, j, k;
     Coordinates(g, edgePoints[t], i, j, k);
-    add(i, j, k, NodeType::Canny, static_cast<float>(radii[t]));
+    nodes.Add(i, j, k, NodeType::Canny, static_cast<float>(radii[t]));
   }
   out.StepSeconds.emplace_back("boundary", SecondsSince(t0));
 
@@ -386,7 +464,7 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
       fh = work;
       rho = f;
     }
-    HessianFeatureMap(fh, g, p.HalftoneGamma, p.FeaturePercentile, parallel, rho, &out.FeatureMaximum, featureFloor,
+    HessianFeatureMap(fh, g, p.HalftoneGamma, p.FeaturePercentile, parallel, rho, &out.FeatureMaximum, floors.Feature,
       p.HessianSigma);
     if (seedAware)
     {
@@ -407,50 +485,21 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
       return out;
     }
     t0 = Clock::now();
-    const std::vector<std::int64_t> dots = Halftone(rho, g, p.HalftoneThreshold);
-    for (std::int64_t d : dots)
+    for (std::int64_t d : Halftone(rho, g, p.HalftoneThreshold))
     {
       int i, j, k;
       Coordinates(g, d, i, j, k);
       if (!AnyInBox(out.EdgeMap, g, i, j, k, h) && (allCanny.empty() || !AnyInBox(allCanny, g, i, j, k, h)))
       {
-        add(i, j, k, NodeType::Halftone, static_cast<float>(h));
+        nodes.Add(i, j, k, NodeType::Halftone, static_cast<float>(h));
       }
     }
     out.StepSeconds.emplace_back("halftone", SecondsSince(t0));
   }
 
-  // 5. Uniform lattice points where no edge voxel and no node lies within the window.
+  // 5. Uniform lattice points.
   t0 = Clock::now();
-  {
-    // Edge voxels count as occupied from here: no uniform point near them (and none lands on one,
-    // as the window around a uniform point is free of them).
-    for (std::int64_t i = 0; i < n; ++i)
-    {
-      occupied[i] |= out.EdgeMap[i];
-    }
-    const int s = p.UniformSpacing;
-    const int start = s / 2;
-    for (int k = is2D ? 0 : start; k < g.Dims[2]; k += s)
-    {
-      for (int j = start; j < g.Dims[1]; j += s)
-      {
-        for (int i = start; i < g.Dims[0]; i += s)
-        {
-          const int l = level(i, j, k);
-          const int m = 1 << l;
-          if (((i - start) / s) % m || ((j - start) / s) % m || (!is2D && ((k - start) / s) % m))
-          {
-            continue;
-          }
-          if (!AnyInBox(occupied, g, i, j, k, h))
-          {
-            add(i, j, k, NodeType::Uniform, 0.5f * s);
-          }
-        }
-      }
-    }
-  }
+  PlaceUniformNodes(g, p.UniformSpacing, h, out.EdgeMap, level, nodes);
   out.StepSeconds.emplace_back("uniform", SecondsSince(t0));
   progress(1.0);
   return out;
