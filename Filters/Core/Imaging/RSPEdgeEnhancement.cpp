@@ -547,49 +547,25 @@ RSPResult OnCoarserGrid(const float* image, const ImageGeometry& g, const std::v
   progress(1.0);
   return out;
 }
-} // namespace
-
-RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const std::vector<std::int64_t>& objectSeeds,
-  const std::vector<std::int64_t>& backgroundSeeds, const RSPParameters& p, const ParallelFor& parallel,
-  const ProgressFunction& progress)
+// The seeds' check: both kinds, no voxel holding both.
+std::string SeedsProblem(const std::vector<std::int64_t>& objectSeeds, const std::vector<std::int64_t>& backgroundSeeds)
 {
-  RSPResult out;
-  out.Error = ValidateParameters(p);
-  if (!out.Error.empty())
-  {
-    return out;
-  }
   if (objectSeeds.empty() || backgroundSeeds.empty())
   {
-    out.Error = "both object and background seeds are needed.";
-    return out;
+    return "both object and background seeds are needed.";
   }
-  {
-    std::vector<std::int64_t> a = objectSeeds, b = backgroundSeeds, both;
-    std::sort(a.begin(), a.end());
-    std::sort(b.begin(), b.end());
-    std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(both));
-    if (!both.empty())
-    {
-      out.Error = std::to_string(both.size()) + " voxel(s) hold both an object and a background seed.";
-      return out;
-    }
-  }
-  const std::int64_t n = g.Size();
-  if (p.MaximumPathVoxels > 0 && n > p.MaximumPathVoxels)
-  {
-    return OnCoarserGrid(image, g, objectSeeds, backgroundSeeds, p, parallel, progress);
-  }
-  auto t0 = Clock::now();
+  std::vector<std::int64_t> a = objectSeeds, b = backgroundSeeds, both;
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(both));
+  return both.empty() ? std::string() : std::to_string(both.size()) + " voxel(s) hold both an object and a background seed.";
+}
 
-  // 1. Pixel cost G (eq. 25) and the marching slowness 1/G (eq. 27).
-  out.GradientRange = RobustRange(image, n);
-  if (!(out.GradientRange > 0.0))
-  {
-    out.Error = "the image is constant: it has no edges to enhance.";
-    return out;
-  }
-  std::vector<float> cost, slowness;
+// Step 1: the pixel cost G = exp(-beta |grad|) (eq. 25) and the marching slowness 1/G (eq. 27).
+void PixelCosts(const float* image, const ImageGeometry& g, const RSPParameters& p, double gradientRange,
+  const ParallelFor& parallel, std::vector<float>& cost, std::vector<float>& slowness)
+{
+  const std::int64_t n = g.Size();
   AssignFresh(cost, static_cast<std::size_t>(n));
   AssignFresh(slowness, static_cast<std::size_t>(n));
   if (p.GradientSigma > 0.0)
@@ -601,7 +577,7 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
   {
     GradientMagnitude(image, g, cost.data(), parallel);
   }
-  const double beta = p.GradientScale * 255.0 / out.GradientRange;
+  const double beta = p.GradientScale * 255.0 / gradientRange;
   parallel(n, 1 << 16, [&](std::int64_t b, std::int64_t e) {
     for (std::int64_t i = b; i < e; ++i)
     {
@@ -611,133 +587,82 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
       slowness[i] = static_cast<float>(std::exp(x));
     }
   });
-  out.StepSeconds.emplace_back("cost", SecondsSince(t0));
-  if (!progress(0.05))
-  {
-    out.Aborted = true;
-    return out;
-  }
+}
 
-  // 2. Marching distance maps, each only as far as its sampling threshold.
-  t0 = Clock::now();
-  out.ObjectThreshold = p.SamplingThreshold;
-  out.BackgroundThreshold = p.SamplingThreshold;
-  out.ObjectDistance = FastMarching(slowness.data(), g, objectSeeds, p.SamplingThreshold, &backgroundSeeds,
-    &out.ObjectThreshold, SubProgress(progress, 0.05, 0.15));
-  if (out.ObjectDistance.empty() || !progress(0.15))
-  {
-    out.Aborted = true;
-    return out;
-  }
-  out.BackgroundDistance = FastMarching(slowness.data(), g, backgroundSeeds, p.SamplingThreshold, &objectSeeds,
-    &out.BackgroundThreshold, SubProgress(progress, 0.15, 0.25));
-  if (out.BackgroundDistance.empty())
-  {
-    out.Aborted = true;
-    return out;
-  }
-  out.StepSeconds.emplace_back("marching", SecondsSince(t0));
-  std::vector<float>().swap(slowness);
-  if (!progress(0.25))
-  {
-    out.Aborted = true;
-    return out;
-  }
-
-  // 3. Sources and sinks.
-  t0 = Clock::now();
-  out.SourceVoxels = RejectionSample(out.ObjectDistance, out.ObjectThreshold, p.Sources, p.RandomSeed * 2ull + 1);
-  out.SinkVoxels = RejectionSample(out.BackgroundDistance, out.BackgroundThreshold, p.Sinks, p.RandomSeed * 2ull + 2);
-  if (out.SourceVoxels.empty() || out.SinkVoxels.empty())
-  {
-    out.Error = "no sources or sinks could be drawn from the marching maps.";
-    return out;
-  }
-  out.StepSeconds.emplace_back("sampling", SecondsSince(t0));
-  if (!progress(0.27))
-  {
-    out.Aborted = true;
-    return out;
-  }
-
-  // 4. All source-sink shortest paths, in the box both maps reach, grown by the margin.
-  t0 = Clock::now();
+// Step 4a: the box the paths run in: what both marching maps reach, grown by the margin.
+PathBox SeedPathBox(const RSPResult& out, const ImageGeometry& g, int margin)
+{
   PathBox box;
+  const Grid grid(g.Dims);
+  std::array<int, 3> lo{ { g.Dims[0], g.Dims[1], g.Dims[2] } }, hi{ { -1, -1, -1 } };
+  for (std::int64_t i = 0; i < g.Size(); ++i)
   {
-    const Grid grid(g.Dims);
-    std::array<int, 3> lo{ { g.Dims[0], g.Dims[1], g.Dims[2] } }, hi{ { -1, -1, -1 } };
-    for (std::int64_t i = 0; i < n; ++i)
+    if (out.ObjectDistance[i] <= out.ObjectThreshold || out.BackgroundDistance[i] <= out.BackgroundThreshold)
     {
-      if (out.ObjectDistance[i] <= out.ObjectThreshold || out.BackgroundDistance[i] <= out.BackgroundThreshold)
+      const std::array<int, 3> c = grid.Coordinates(i);
+      for (int a = 0; a < 3; ++a)
       {
-        const std::array<int, 3> c = grid.Coordinates(i);
-        for (int a = 0; a < 3; ++a)
-        {
-          lo[a] = std::min(lo[a], c[a]);
-          hi[a] = std::max(hi[a], c[a]);
-        }
+        lo[a] = std::min(lo[a], c[a]);
+        hi[a] = std::max(hi[a], c[a]);
       }
     }
-    for (int a = 0; a < 3; ++a)
-    {
-      box.Lo[a] = std::max(0, lo[a] - p.PathMargin);
-      box.Dims[a] = std::min(g.Dims[a] - 1, hi[a] + p.PathMargin) - box.Lo[a] + 1;
-    }
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    box.Lo[a] = std::max(0, lo[a] - margin);
+    box.Dims[a] = std::min(g.Dims[a] - 1, hi[a] + margin) - box.Lo[a] + 1;
   }
   box.Frame.Dims = box.Dims;
-  out.PathVoxels = box.Size();
-  if (!progress(0.28))
-  {
-    out.Aborted = true;
-    return out;
-  }
-  if (box.Size() >= std::numeric_limits<std::uint32_t>::max())
-  {
-    out.Error = "the region the paths run in is too large (more than 4 G voxels).";
-    return out;
-  }
-  const Grid local(box.Dims);
-  const std::array<double, 3> h = AxisSteps(g);
-  // Integer edge weights (G_i + G_j) / 2 x step, in 1/256 of a flat voxel step, at least 1 (0: no
-  // edge, beyond the box).
+  return box;
+}
+
+// Step 4b: integer edge weights (G_i + G_j) / 2 x step in the box, in 1/256 of a flat voxel step, at
+// least 1 (0: no edge, beyond the box), `axes` per voxel; returns the largest.
+int PathWeights(const std::vector<float>& cost, const ImageGeometry& g, const PathBox& box, const ParallelFor& parallel,
+  std::vector<std::uint16_t>& weight)
+{
   constexpr double Quantum = 256.0;
+  const Grid local(box.Dims), full(g.Dims);
   const int axes = local.Directions / 2;
-  std::vector<std::uint16_t> weight(static_cast<std::size_t>(box.Size()) * axes, 0);
-  int maxWeight = 1;
-  {
-    const Grid full(g.Dims);
-    std::vector<int> rowMax(static_cast<std::size_t>(box.Dims[1]) * box.Dims[2], 1);
-    parallel(static_cast<std::int64_t>(rowMax.size()), 16, [&](std::int64_t r0, std::int64_t r1) {
-      for (std::int64_t r = r0; r < r1; ++r)
+  const std::array<double, 3> h = AxisSteps(g);
+  weight.assign(static_cast<std::size_t>(box.Size()) * axes, 0);
+  std::vector<int> rowMax(static_cast<std::size_t>(box.Dims[1]) * box.Dims[2], 1);
+  parallel(static_cast<std::int64_t>(rowMax.size()), 16, [&](std::int64_t r0, std::int64_t r1) {
+    for (std::int64_t r = r0; r < r1; ++r)
+    {
+      const int j = static_cast<int>(r % box.Dims[1]), k = static_cast<int>(r / box.Dims[1]);
+      for (int i = 0; i < box.Dims[0]; ++i)
       {
-        const int j = static_cast<int>(r % box.Dims[1]), k = static_cast<int>(r / box.Dims[1]);
-        for (int i = 0; i < box.Dims[0]; ++i)
+        const std::array<int, 3> c{ { i, j, k } };
+        const std::int64_t l = (static_cast<std::int64_t>(k) * box.Dims[1] + j) * box.Dims[0] + i;
+        const std::int64_t v = g.Index(i + box.Lo[0], j + box.Lo[1], k + box.Lo[2]);
+        for (int a = 0; a < axes; ++a)
         {
-          const std::array<int, 3> c{ { i, j, k } };
-          const std::int64_t l = (static_cast<std::int64_t>(k) * box.Dims[1] + j) * box.Dims[0] + i;
-          const std::int64_t v = g.Index(i + box.Lo[0], j + box.Lo[1], k + box.Lo[2]);
-          for (int a = 0; a < local.Directions / 2; ++a)
+          if (!local.Inside(c, 2 * a))
           {
-            if (!local.Inside(c, 2 * a))
-            {
-              continue;
-            }
-            const std::int64_t q = v + full.Offset[2 * a];
-            const double x = Quantum * 0.5 * (static_cast<double>(cost[v]) + cost[q]) * h[a];
-            const int wq = std::max(1, std::min(65535, static_cast<int>(std::lround(x))));
-            weight[static_cast<std::size_t>(l) * axes + a] = static_cast<std::uint16_t>(wq);
-            rowMax[r] = std::max(rowMax[r], wq);
+            continue;
           }
+          const std::int64_t q = v + full.Offset[2 * a];
+          const double x = Quantum * 0.5 * (static_cast<double>(cost[v]) + cost[q]) * h[a];
+          const int wq = std::max(1, std::min(65535, static_cast<int>(std::lround(x))));
+          weight[static_cast<std::size_t>(l) * axes + a] = static_cast<std::uint16_t>(wq);
+          rowMax[r] = std::max(rowMax[r], wq);
         }
       }
-    });
-    maxWeight = *std::max_element(rowMax.begin(), rowMax.end());
-  }
-  if (!progress(0.3))
-  {
-    out.Aborted = true;
-    return out;
-  }
+    }
+  });
+  return *std::max_element(rowMax.begin(), rowMax.end());
+}
+
+// Step 4c: every source's shortest-path tree to all sinks, counting the voxels each path crosses
+// (out.EdgeConfidence). Workspaces are shared by the threads through a pool; the counts are
+// integers, so their sum does not depend on which workspace ran which source. The trees run on a
+// worker thread (itself using `parallel`); this thread reports progress as sources finish, every
+// 0.1 s at most, and on abort cancels the trees, which stop within a bucket. False when aborted.
+bool CountPaths(const ImageGeometry& g, const PathBox& box, const std::vector<std::uint16_t>& weight, int maxWeight,
+  const ParallelFor& parallel, const ProgressFunction& progress, RSPResult& out)
+{
+  const Grid local(box.Dims);
   std::vector<std::uint32_t> sinks;
   std::vector<std::uint8_t> isSink(static_cast<std::size_t>(box.Size()), 0);
   for (std::int64_t t : out.SinkVoxels)
@@ -746,8 +671,6 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
     sinks.push_back(l);
     isSink[l] = 1;
   }
-  // Workspaces are shared by the threads through a pool; the counts are integers, so their sum
-  // does not depend on which workspace ran which source.
   std::mutex poolLock;
   std::vector<std::unique_ptr<Workspace>> all;
   std::vector<Workspace*> idle;
@@ -776,8 +699,6 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
     idle.push_back(w);
   };
   const std::int64_t nSources = static_cast<std::int64_t>(out.SourceVoxels.size());
-  // The trees run on a worker thread (itself using `parallel`); this thread reports progress as
-  // sources finish, every 0.1 s at most, and on abort cancels the trees, which stop within a bucket.
   std::atomic<bool> cancel{ false };
   std::atomic<std::int64_t> done{ 0 };
   std::mutex doneLock;
@@ -814,7 +735,7 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
       doneSignal.wait_for(lock, std::chrono::milliseconds(100));
       const double fraction = static_cast<double>(done) / static_cast<double>(nSources);
       lock.unlock();
-      go = progress(0.3 + 0.6 * fraction);
+      go = progress(fraction);
       lock.lock();
       if (!go)
       {
@@ -830,11 +751,10 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
   }
   if (!go)
   {
-    out.Aborted = true;
-    return out;
+    return false;
   }
   out.Paths = nSources * static_cast<std::int64_t>(sinks.size());
-  AssignFresh(out.EdgeConfidence, static_cast<std::size_t>(n), 0.f);
+  AssignFresh(out.EdgeConfidence, static_cast<std::size_t>(g.Size()), 0.f);
   for (std::int64_t l = 0; l < box.Size(); ++l)
   {
     std::uint64_t c = 0;
@@ -846,6 +766,107 @@ RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const s
     {
       out.EdgeConfidence[box.Global(g, l)] = static_cast<float>(c);
     }
+  }
+  return true;
+}
+} // namespace
+
+RSPResult RSPEdgeEnhancement(const float* image, const ImageGeometry& g, const std::vector<std::int64_t>& objectSeeds,
+  const std::vector<std::int64_t>& backgroundSeeds, const RSPParameters& p, const ParallelFor& parallel,
+  const ProgressFunction& progress)
+{
+  RSPResult out;
+  out.Error = ValidateParameters(p);
+  if (out.Error.empty())
+  {
+    out.Error = SeedsProblem(objectSeeds, backgroundSeeds);
+  }
+  if (!out.Error.empty())
+  {
+    return out;
+  }
+  const std::int64_t n = g.Size();
+  if (p.MaximumPathVoxels > 0 && n > p.MaximumPathVoxels)
+  {
+    return OnCoarserGrid(image, g, objectSeeds, backgroundSeeds, p, parallel, progress);
+  }
+  auto aborted = [&](bool goOn) {
+    out.Aborted = !goOn;
+    return out.Aborted;
+  };
+  auto t0 = Clock::now();
+
+  // 1. Pixel cost and marching slowness.
+  out.GradientRange = RobustRange(image, n);
+  if (!(out.GradientRange > 0.0))
+  {
+    out.Error = "the image is constant: it has no edges to enhance.";
+    return out;
+  }
+  std::vector<float> cost, slowness;
+  PixelCosts(image, g, p, out.GradientRange, parallel, cost, slowness);
+  out.StepSeconds.emplace_back("cost", SecondsSince(t0));
+  if (aborted(progress(0.05)))
+  {
+    return out;
+  }
+
+  // 2. Marching distance maps, each only as far as its sampling threshold.
+  t0 = Clock::now();
+  out.ObjectThreshold = p.SamplingThreshold;
+  out.BackgroundThreshold = p.SamplingThreshold;
+  out.ObjectDistance = FastMarching(slowness.data(), g, objectSeeds, p.SamplingThreshold, &backgroundSeeds,
+    &out.ObjectThreshold, SubProgress(progress, 0.05, 0.15));
+  if (aborted(!out.ObjectDistance.empty() && progress(0.15)))
+  {
+    return out;
+  }
+  out.BackgroundDistance = FastMarching(slowness.data(), g, backgroundSeeds, p.SamplingThreshold, &objectSeeds,
+    &out.BackgroundThreshold, SubProgress(progress, 0.15, 0.25));
+  if (aborted(!out.BackgroundDistance.empty()))
+  {
+    return out;
+  }
+  out.StepSeconds.emplace_back("marching", SecondsSince(t0));
+  std::vector<float>().swap(slowness);
+  if (aborted(progress(0.25)))
+  {
+    return out;
+  }
+
+  // 3. Sources and sinks.
+  t0 = Clock::now();
+  out.SourceVoxels = RejectionSample(out.ObjectDistance, out.ObjectThreshold, p.Sources, p.RandomSeed * 2ull + 1);
+  out.SinkVoxels = RejectionSample(out.BackgroundDistance, out.BackgroundThreshold, p.Sinks, p.RandomSeed * 2ull + 2);
+  if (out.SourceVoxels.empty() || out.SinkVoxels.empty())
+  {
+    out.Error = "no sources or sinks could be drawn from the marching maps.";
+    return out;
+  }
+  out.StepSeconds.emplace_back("sampling", SecondsSince(t0));
+  if (aborted(progress(0.27)))
+  {
+    return out;
+  }
+
+  // 4. All source-sink shortest paths in the box both maps reach.
+  t0 = Clock::now();
+  const PathBox box = SeedPathBox(out, g, p.PathMargin);
+  out.PathVoxels = box.Size();
+  if (aborted(progress(0.28)))
+  {
+    return out;
+  }
+  if (box.Size() >= std::numeric_limits<std::uint32_t>::max())
+  {
+    out.Error = "the region the paths run in is too large (more than 4 G voxels).";
+    return out;
+  }
+  std::vector<std::uint16_t> weight;
+  const int maxWeight = PathWeights(cost, g, box, parallel, weight);
+  if (aborted(progress(0.3)) || aborted(CountPaths(g, box, weight, maxWeight, parallel, SubProgress(progress, 0.3, 0.9), out)))
+  {
+    return out;
   }
   out.StepSeconds.emplace_back("paths", SecondsSince(t0));
 
