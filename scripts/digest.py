@@ -5,7 +5,8 @@ For each case (bundled Data/ and ../shared/data/cases) prints one line per outpu
 the node points and arrays, of the mesh (points, cells, every cell array by value) and of its
 voxel -> element map, of the smoothed mesh (stage 3 at its defaults, default backend) and its map, of the
 super-voxel labels (cells and label image), of Segmentation Surface Smoothing's output (the labelled
-mesh's points and the boundary's faces) and of the voxel cut's labels, at the default
+mesh's points and the boundary's faces), of the voxel cut's labels and of RSP Edge Enhancement's
+outputs with the seed-aware nodes made from them (one line, last, so older digests compare line for line), at the default
 properties (--cut overrides properties of both cuts, e.g. the defaults of an older commit); 3D cases
 also with the CGAL backend. Compare two runs with diff.
 """
@@ -77,6 +78,12 @@ def main():
                                                           *[cell_array(s, a) for a in CELL_ARRAYS])))
                 lines.append("%s smoothed owners %s" % (tag, owners(smoothed)))
         lines.append("%s voxelcut %s" % (name, sha(fm.v2n(fm.fetch(case.voxel_cut(**cut_properties)).GetPointData().GetScalars()))))
+        rsp = case.rsp()
+        r, contour = fm.fetch(rsp, 0), fm.fetch(rsp, 1)
+        seeded = fm.fetch(case.feature_nodes(edges=rsp))
+        lines.append("%s rsp %s" % (name, sha(*[fm.v2n(r.GetPointData().GetArray(a)) for a in (N.EdgeConfidence, N.EdgeMap)],
+                                             fm.v2n(contour.GetPoints().GetData()) if contour.GetPoints() else [],
+                                             fm.v2n(seeded.GetPoints().GetData()))))
         print(lines[-1], flush=True)
     text = "\n".join(lines) + "\n"
     print(text)
