@@ -27,40 +27,28 @@ inline std::array<int, 3> QuantisedDirection(float gx, float gy, float gz)
 }
 } // namespace
 
-std::vector<std::uint8_t> CannyEdges(const float* f, const ImageGeometry& g, double low, double high, double percentile,
-  const ParallelFor& parallel, double* gradientMaximum, float* magnitudeBuffer, double lowFloor, double highFloor,
-  double smoothingSigma)
+namespace
 {
-  const std::int64_t n = g.Size();
-  std::vector<float> ownMagnitude(magnitudeBuffer ? 0 : n);
-  float* mag = magnitudeBuffer ? magnitudeBuffer : ownMagnitude.data();
-  GradientMagnitude(f, g, mag, parallel);
-  const double gmax = RobustMaximum(mag, n, percentile, parallel);
-  if (gradientMaximum)
-  {
-    *gradientMaximum = gmax;
-  }
-  std::vector<std::uint8_t> state; // 0 none, 1 weak candidate, 2 strong
-  AssignFresh(state, n, std::uint8_t(0));
-  if (gmax <= 0.0)
-  {
-    return state;
-  }
-  const float lowValue = static_cast<float>(std::max(low * gmax, lowFloor));
-  const float highValue = static_cast<float>(std::max(high * gmax, highFloor));
+// Canny's two thresholds on the gradient magnitude, each raised to its noise floor, which grows
+// near the border, where the noise's gradient varies more (Border: per axis, per index).
+struct CannyThresholds
+{
+  float Low = 0.f, High = 0.f, LowFloor = 0.f, HighFloor = 0.f;
+  bool Floored = false;
+  std::array<std::vector<float>, 3> Border;
+};
+
+// Step 2: non-maximum suppression along the quantised gradient direction; ties resolved by ">" on
+// one side and ">=" on the other, so a two-voxel plateau keeps exactly one voxel. `state`: 0 none,
+// 1 weak candidate, 2 strong.
+void SuppressNonMaxima(const float* f, const float* mag, const ImageGeometry& g, const CannyThresholds& t,
+  const ParallelFor& parallel, std::vector<std::uint8_t>& state)
+{
   const std::int64_t sy = g.Dims[0], sz = g.SliceStride();
   const std::int64_t rows = static_cast<std::int64_t>(g.Dims[1]) * g.Dims[2];
-  // Near the border the noise's gradient varies more: the floors grow with it there.
-  const bool floored = lowFloor > 0.0 || highFloor > 0.0;
-  std::array<std::vector<float>, 3> border;
-  for (int a = 0; a < 3 && floored; ++a)
-  {
-    border[a] = BorderNoiseFactors(g.Dims[a], smoothingSigma, { 0.5, 0.0, -0.5 });
-  }
-  const float lowFloorValue = static_cast<float>(lowFloor), highFloorValue = static_cast<float>(highFloor);
-
-  // Non-maximum suppression along the quantised gradient direction; ties resolved by ">" on one
-  // side and ">=" on the other, so a two-voxel plateau keeps exactly one voxel.
+  const bool floored = t.Floored;
+  const float lowValue = t.Low, highValue = t.High, lowFloorValue = t.LowFloor, highFloorValue = t.HighFloor;
+  const auto& border = t.Border;
   parallel(rows, 16, [&, mag](std::int64_t r0, std::int64_t r1) {
     // Locals, not captured references: the byte stores into `state` may alias anything, and would
     // force a reload of every captured value per voxel.
@@ -138,8 +126,14 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const ImageGeometry& g, dou
       }
     }
   });
-  // Hysteresis: grow the strong voxels through connected candidates, marking visited ones 3. The
-  // result (the candidate components that hold a strong voxel) does not depend on visiting order.
+}
+
+// Step 3: hysteresis: the strong voxels grown through connected candidates (visited ones marked 3,
+// then the only edges). The result, the candidate components that hold a strong voxel, does not
+// depend on visiting order.
+void Hysteresis(const ImageGeometry& g, const ParallelFor& parallel, std::vector<std::uint8_t>& state)
+{
+  const std::int64_t n = g.Size(), sy = g.Dims[0], sz = g.SliceStride();
   const int kr = g.Is2D() ? 0 : 1;
   const int nx = g.Dims[0], ny = g.Dims[1], nz = g.Dims[2];
   std::vector<std::int64_t> offsets;
@@ -213,6 +207,43 @@ std::vector<std::uint8_t> CannyEdges(const float* f, const ImageGeometry& g, dou
       state[i] = state[i] == 3 ? 1 : 0;
     }
   });
+}
+} // namespace
+
+std::vector<std::uint8_t> CannyEdges(const float* f, const ImageGeometry& g, double low, double high, double percentile,
+  const ParallelFor& parallel, double* gradientMaximum, float* magnitudeBuffer, double lowFloor, double highFloor,
+  double smoothingSigma)
+{
+  const std::int64_t n = g.Size();
+  std::vector<float> ownMagnitude(magnitudeBuffer ? 0 : n);
+  float* mag = magnitudeBuffer ? magnitudeBuffer : ownMagnitude.data();
+  GradientMagnitude(f, g, mag, parallel);
+  const double gmax = RobustMaximum(mag, n, percentile, parallel);
+  if (gradientMaximum)
+  {
+    *gradientMaximum = gmax;
+  }
+  std::vector<std::uint8_t> state; // 0 none, 1 weak candidate, 2 strong
+  AssignFresh(state, n, std::uint8_t(0));
+  if (gmax <= 0.0)
+  {
+    return state;
+  }
+  // 1. The thresholds: fractions of the robust maximum, each at least its noise floor.
+  CannyThresholds t;
+  t.Low = static_cast<float>(std::max(low * gmax, lowFloor));
+  t.High = static_cast<float>(std::max(high * gmax, highFloor));
+  t.Floored = lowFloor > 0.0 || highFloor > 0.0;
+  for (int a = 0; a < 3 && t.Floored; ++a)
+  {
+    t.Border[a] = BorderNoiseFactors(g.Dims[a], smoothingSigma, { 0.5, 0.0, -0.5 });
+  }
+  t.LowFloor = static_cast<float>(lowFloor);
+  t.HighFloor = static_cast<float>(highFloor);
+  // 2-3. Thin, then connect.
+  SuppressNonMaxima(f, mag, g, t, parallel, state);
+  Hysteresis(g, parallel, state);
+
   return state;
 }
 } // namespace featuremesh
