@@ -68,6 +68,12 @@ private:
     // rounding error, so |n| would not do).
     double Band;
   };
+  // The element's face planes (each from its vertex ids in ascending order, positive towards the
+  // opposite vertex) and its bounding box in index space; true when a vertex is off the lattice.
+  bool ElementFaces(const std::int64_t* cell, Face* face, double* lo, double* hi) const;
+  // A tetrahedron's rows in slice k: [jLo, jHi] narrowed to the y-range of its cross-section (where
+  // its edges cross z = k), widened far beyond the rounding; false when the slice misses it.
+  bool SliceRows(const std::int64_t* cell, int k, int& jLo, int& jHi) const;
   bool Owns(const Face* face, int faces, bool offLattice, double x, double y, double z) const;
   bool ExactTie(const Face& face, int faces) const;
   bool LatticeTie(const double* n, int faces, double x, double y, double z) const;
@@ -219,15 +225,15 @@ inline bool ElementRasterizer::ExactTie(const Face& F, int faces) const
   return F.Sign * side > 0;
 }
 
-template <typename SpanVisitor>
-void ElementRasterizer::ForEachSpan(std::int64_t e, SpanVisitor&& visit) const
+inline bool ElementRasterizer::ElementFaces(const std::int64_t* cell, Face* face, double* lo, double* hi) const
 {
-  const std::int64_t* cell = this->M->Cell(e);
   const auto& P = this->M->Points();
-  const auto& G = this->M->Geometry();
   const int faces = this->M->VerticesPerCell();
-  // Plane per face: lambda(p) = n.p + d, positive on the side of the opposite vertex.
-  double lo[3] = { 1e300, 1e300, 1e300 }, hi[3] = { -1e300, -1e300, -1e300 };
+  for (int a = 0; a < 3; ++a)
+  {
+    lo[a] = 1e300;
+    hi[a] = -1e300;
+  }
   bool offLattice = false;
   for (int v = 0; v < faces; ++v)
   {
@@ -239,10 +245,10 @@ void ElementRasterizer::ForEachSpan(std::int64_t e, SpanVisitor&& visit) const
       offLattice = offLattice || q[a] != std::floor(q[a]);
     }
   }
-  Face face[4];
-  // Each face's plane from its vertex ids in ascending order, so that the two elements sharing a
-  // face compute the same numbers and exactly opposite signs: every centre has one owner even for
-  // nodes off the voxel lattice (on it, all of this is exact integer arithmetic anyway).
+  // Plane per face: lambda(p) = n.p + d, positive on the side of the opposite vertex, from its
+  // vertex ids in ascending order, so that the two elements sharing a face compute the same numbers
+  // and exactly opposite signs: every centre has one owner even for nodes off the voxel lattice (on
+  // it, all of this is exact integer arithmetic anyway).
   for (int f = 0; f < faces; ++f)
   {
     std::int64_t ids[3];
@@ -294,6 +300,50 @@ void ElementRasterizer::ForEachSpan(std::int64_t e, SpanVisitor&& visit) const
       face[f].Vertex[v] = &P[ids[v]];
     }
   }
+  return offLattice;
+}
+
+inline bool ElementRasterizer::SliceRows(const std::int64_t* cell, int k, int& jLo, int& jHi) const
+{
+  const auto& P = this->M->Points();
+  double yLo = 1e300, yHi = -1e300;
+  for (int a = 0; a < 4; ++a)
+  {
+    const auto& p = P[cell[a]];
+    if (p[2] == k)
+    {
+      yLo = std::min(yLo, p[1]);
+      yHi = std::max(yHi, p[1]);
+    }
+    for (int b = a + 1; b < 4; ++b)
+    {
+      const auto& q = P[cell[b]];
+      if ((p[2] < k && q[2] > k) || (p[2] > k && q[2] < k))
+      {
+        const double y = p[1] + (k - p[2]) / (q[2] - p[2]) * (q[1] - p[1]);
+        yLo = std::min(yLo, y);
+        yHi = std::max(yHi, y);
+      }
+    }
+  }
+  if (!(yLo <= yHi))
+  {
+    return false;
+  }
+  jLo = std::max(jLo, static_cast<int>(std::ceil(yLo - 1e-6)));
+  jHi = std::min(jHi, static_cast<int>(std::floor(yHi + 1e-6)));
+  return true;
+}
+
+template <typename SpanVisitor>
+void ElementRasterizer::ForEachSpan(std::int64_t e, SpanVisitor&& visit) const
+{
+  const std::int64_t* cell = this->M->Cell(e);
+  const auto& G = this->M->Geometry();
+  const int faces = this->M->VerticesPerCell();
+  Face face[4];
+  double lo[3], hi[3];
+  const bool offLattice = this->ElementFaces(cell, face, lo, hi);
   const int i0 = std::max(0, static_cast<int>(std::ceil(lo[0]))), i1 = std::min(G.Dims[0] - 1, static_cast<int>(std::floor(hi[0])));
   const int j0 = std::max(0, static_cast<int>(std::ceil(lo[1]))), j1 = std::min(G.Dims[1] - 1, static_cast<int>(std::floor(hi[1])));
   const int k0 = faces == 3 ? 0 : std::max(0, static_cast<int>(std::ceil(lo[2])));
@@ -312,37 +362,10 @@ void ElementRasterizer::ForEachSpan(std::int64_t e, SpanVisitor&& visit) const
   const int widen = this->ExactBounds || offLattice ? 0 : 1;
   for (int k = k0; k <= k1; ++k)
   {
-    // A tetrahedron's rows in slice k: the y-range of its cross-section (where its edges cross
-    // z = k), widened far beyond the rounding; rows outside it own nothing.
     int jLo = j0, jHi = j1;
-    if (faces == 4)
+    if (faces == 4 && !this->SliceRows(cell, k, jLo, jHi))
     {
-      double yLo = 1e300, yHi = -1e300;
-      for (int a = 0; a < 4; ++a)
-      {
-        const auto& p = P[cell[a]];
-        if (p[2] == k)
-        {
-          yLo = std::min(yLo, p[1]);
-          yHi = std::max(yHi, p[1]);
-        }
-        for (int b = a + 1; b < 4; ++b)
-        {
-          const auto& q = P[cell[b]];
-          if ((p[2] < k && q[2] > k) || (p[2] > k && q[2] < k))
-          {
-            const double y = p[1] + (k - p[2]) / (q[2] - p[2]) * (q[1] - p[1]);
-            yLo = std::min(yLo, y);
-            yHi = std::max(yHi, y);
-          }
-        }
-      }
-      if (!(yLo <= yHi))
-      {
-        continue;
-      }
-      jLo = std::max(j0, static_cast<int>(std::ceil(yLo - 1e-6)));
-      jHi = std::min(j1, static_cast<int>(std::floor(yHi + 1e-6)));
+      continue;
     }
     for (int j = jLo; j <= jHi; ++j)
     {
