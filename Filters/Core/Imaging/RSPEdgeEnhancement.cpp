@@ -384,77 +384,124 @@ void PathsFromSource(std::uint32_t source, const std::vector<std::uint32_t>& sin
 }
 // The stage on the grid coarsened by the smallest integer factor f that brings it within
 // MaximumPathVoxels (block means of the image), its maps and EC brought back by nearest neighbour.
-RSPResult OnCoarserGrid(const float* image, const ImageGeometry& g, const std::vector<std::int64_t>& objectSeeds,
-  const std::vector<std::int64_t>& backgroundSeeds, const RSPParameters& p, const ParallelFor& parallel,
-  const ProgressFunction& progress)
+// The smallest block factor f >= 2 whose coarse grid (f x f (x f) blocks, spacing x f) holds at
+// most `maxVoxels` voxels.
+int CoarseGrid(const ImageGeometry& g, std::int64_t maxVoxels, ImageGeometry& c)
 {
   const int dim = g.Dimension();
-  int f = 2;
-  ImageGeometry c = g;
-  for (;; ++f)
+  c = g;
+  for (int f = 2;; ++f)
   {
     for (int a = 0; a < dim; ++a)
     {
       c.Dims[a] = (g.Dims[a] + f - 1) / f;
       c.Spacing[a] = g.Spacing[a] * f;
     }
-    if (c.Size() <= p.MaximumPathVoxels || (c.Dims[0] <= 2 && c.Dims[1] <= 2))
+    if (c.Size() <= maxVoxels || (c.Dims[0] <= 2 && c.Dims[1] <= 2))
     {
-      break;
+      return f;
     }
   }
-  const auto t0 = Clock::now();
-  const auto block = [&](std::int64_t v) {
-    const std::array<int, 3> x = g.Coordinates(v);
-    return c.Index(x[0] / f, x[1] / f, dim == 3 ? x[2] / f : 0);
-  };
+}
+
+// The image's block means on the coarse grid c: coarse slab by coarse slab (independent sums), row
+// by row without divisions.
+std::vector<float> BlockMeans(const float* image, const ImageGeometry& g, const ImageGeometry& c, int f, const ParallelFor& parallel)
+{
+  const int dim = g.Dimension();
   std::vector<float> coarse(static_cast<std::size_t>(c.Size()), 0.f);
-  {
-    // Coarse slab by coarse slab (independent sums), row by row without divisions.
-    parallel(c.Dims[2], 1, [&](std::int64_t c0, std::int64_t c1) {
-      std::vector<double> sum(static_cast<std::size_t>(c.SliceStride()));
-      std::vector<int> count(sum.size());
-      for (std::int64_t ck = c0; ck < c1; ++ck)
+  parallel(c.Dims[2], 1, [&](std::int64_t c0, std::int64_t c1) {
+    std::vector<double> sum(static_cast<std::size_t>(c.SliceStride()));
+    std::vector<int> count(sum.size());
+    for (std::int64_t ck = c0; ck < c1; ++ck)
+    {
+      std::fill(sum.begin(), sum.end(), 0.0);
+      std::fill(count.begin(), count.end(), 0);
+      const int k0 = dim == 3 ? static_cast<int>(ck) * f : 0, k1 = dim == 3 ? std::min(g.Dims[2], k0 + f) : 1;
+      for (int k = k0; k < k1; ++k)
       {
-        std::fill(sum.begin(), sum.end(), 0.0);
-        std::fill(count.begin(), count.end(), 0);
-        const int k0 = dim == 3 ? static_cast<int>(ck) * f : 0, k1 = dim == 3 ? std::min(g.Dims[2], k0 + f) : 1;
-        for (int k = k0; k < k1; ++k)
+        for (int j = 0; j < g.Dims[1]; ++j)
         {
-          for (int j = 0; j < g.Dims[1]; ++j)
+          const float* row = image + g.Index(0, j, k);
+          const std::int64_t base = static_cast<std::int64_t>(j / f) * c.Dims[0];
+          for (int i = 0, ci = 0, left = f; i < g.Dims[0]; ++i)
           {
-            const float* row = image + g.Index(0, j, k);
-            const std::int64_t base = static_cast<std::int64_t>(j / f) * c.Dims[0];
-            for (int i = 0, ci = 0, left = f; i < g.Dims[0]; ++i)
+            sum[base + ci] += row[i];
+            ++count[base + ci];
+            if (--left == 0)
             {
-              sum[base + ci] += row[i];
-              ++count[base + ci];
-              if (--left == 0)
-              {
-                ++ci;
-                left = f;
-              }
+              ++ci;
+              left = f;
             }
           }
         }
-        for (std::int64_t b = 0; b < c.SliceStride(); ++b)
+      }
+      for (std::int64_t b = 0; b < c.SliceStride(); ++b)
+      {
+        coarse[ck * c.SliceStride() + b] = static_cast<float>(sum[b] / count[b]);
+      }
+    }
+  });
+  return coarse;
+}
+
+// The coarse result on the fine grid: each voxel takes its block's edge confidence, edge map and
+// distances (the distances in fine units); row by row without divisions.
+void Upsample(const RSPResult& r, const ImageGeometry& g, const ImageGeometry& c, int f, const ParallelFor& parallel,
+  RSPResult& out)
+{
+  const int dim = g.Dimension();
+  const std::int64_t n = g.Size();
+  AssignFresh(out.EdgeConfidence, static_cast<std::size_t>(n));
+  AssignFresh(out.EdgeMap, static_cast<std::size_t>(n));
+  AssignFresh(out.ObjectDistance, static_cast<std::size_t>(n));
+  AssignFresh(out.BackgroundDistance, static_cast<std::size_t>(n));
+  const float scale = static_cast<float>(f);
+  parallel(static_cast<std::int64_t>(g.Dims[1]) * g.Dims[2], 64, [&](std::int64_t r0, std::int64_t r1) {
+    for (std::int64_t row = r0; row < r1; ++row)
+    {
+      const int j = static_cast<int>(row % g.Dims[1]), k = static_cast<int>(row / g.Dims[1]);
+      const std::int64_t v0 = g.Index(0, j, k), k0 = c.Index(0, j / f, dim == 3 ? k / f : 0);
+      for (int i = 0, ci = 0, left = f; i < g.Dims[0]; ++i)
+      {
+        const std::int64_t v = v0 + i, kc = k0 + ci;
+        out.EdgeConfidence[v] = r.EdgeConfidence[kc];
+        out.EdgeMap[v] = r.EdgeMap[kc];
+        out.ObjectDistance[v] = r.ObjectDistance[kc] * scale;
+        out.BackgroundDistance[v] = r.BackgroundDistance[kc] * scale;
+        if (--left == 0)
         {
-          coarse[ck * c.SliceStride() + b] = static_cast<float>(sum[b] / count[b]);
+          ++ci;
+          left = f;
         }
       }
-    });
-  }
+    }
+  });
+}
+
+RSPResult OnCoarserGrid(const float* image, const ImageGeometry& g, const std::vector<std::int64_t>& objectSeeds,
+  const std::vector<std::int64_t>& backgroundSeeds, const RSPParameters& p, const ParallelFor& parallel,
+  const ProgressFunction& progress)
+{
+  const int dim = g.Dimension();
+  ImageGeometry c;
+  const int f = CoarseGrid(g, p.MaximumPathVoxels, c);
+  const auto t0 = Clock::now();
+  const std::vector<float> coarse = BlockMeans(image, g, c, f, parallel);
   if (!progress(0.03))
   {
     RSPResult aborted;
     aborted.Aborted = true;
     return aborted;
   }
+  // The seeds' blocks; a block holding seeds of both kinds counts as object: seeds of the two kinds
+  // a voxel or two apart.
   const auto toCoarse = [&](const std::vector<std::int64_t>& seeds) {
     std::vector<std::int64_t> out;
     for (std::int64_t s : seeds)
     {
-      out.push_back(block(s));
+      const std::array<int, 3> x = g.Coordinates(s);
+      out.push_back(c.Index(x[0] / f, x[1] / f, dim == 3 ? x[2] / f : 0));
     }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
@@ -464,7 +511,6 @@ RSPResult OnCoarserGrid(const float* image, const ImageGeometry& g, const std::v
   std::vector<std::int64_t> background;
   for (std::int64_t b : toCoarse(backgroundSeeds))
   {
-    // A block holding seeds of both kinds counts as object: seeds of the two kinds a voxel or two apart.
     if (!std::binary_search(object.begin(), object.end(), b))
     {
       background.push_back(b);
@@ -491,33 +537,7 @@ RSPResult OnCoarserGrid(const float* image, const ImageGeometry& g, const std::v
   out.GradientRange = r.GradientRange;
   out.Paths = r.Paths;
   out.PathVoxels = r.PathVoxels;
-  const std::int64_t n = g.Size();
-  AssignFresh(out.EdgeConfidence, static_cast<std::size_t>(n));
-  AssignFresh(out.EdgeMap, static_cast<std::size_t>(n));
-  AssignFresh(out.ObjectDistance, static_cast<std::size_t>(n));
-  AssignFresh(out.BackgroundDistance, static_cast<std::size_t>(n));
-  // Row by row without divisions.
-  const float scale = static_cast<float>(f);
-  parallel(static_cast<std::int64_t>(g.Dims[1]) * g.Dims[2], 64, [&](std::int64_t r0, std::int64_t r1) {
-    for (std::int64_t row = r0; row < r1; ++row)
-    {
-      const int j = static_cast<int>(row % g.Dims[1]), k = static_cast<int>(row / g.Dims[1]);
-      const std::int64_t v0 = g.Index(0, j, k), k0 = c.Index(0, j / f, dim == 3 ? k / f : 0);
-      for (int i = 0, ci = 0, left = f; i < g.Dims[0]; ++i)
-      {
-        const std::int64_t v = v0 + i, kc = k0 + ci;
-        out.EdgeConfidence[v] = r.EdgeConfidence[kc];
-        out.EdgeMap[v] = r.EdgeMap[kc];
-        out.ObjectDistance[v] = r.ObjectDistance[kc] * scale;
-        out.BackgroundDistance[v] = r.BackgroundDistance[kc] * scale;
-        if (--left == 0)
-        {
-          ++ci;
-          left = f;
-        }
-      }
-    }
-  });
+  Upsample(r, g, c, f, parallel, out);
   // Samples at their block's centre voxel (inside the image).
   const auto toFine = [&](const std::vector<std::int64_t>& voxels) {
     std::vector<std::int64_t> fine;
@@ -547,6 +567,7 @@ RSPResult OnCoarserGrid(const float* image, const ImageGeometry& g, const std::v
   progress(1.0);
   return out;
 }
+
 // The seeds' check: both kinds, no voxel holding both.
 std::string SeedsProblem(const std::vector<std::int64_t>& objectSeeds, const std::vector<std::int64_t>& backgroundSeeds)
 {
