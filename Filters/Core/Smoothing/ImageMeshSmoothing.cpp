@@ -429,27 +429,115 @@ std::int64_t SnapNodesToBox(const ImageGeometry& g, std::vector<V3>& points)
 // its slivers' opposite faces (the directions that open a flat tetrahedron) and along the axes,
 // of 1/4, 1/8 and 1/16 of its shortest edge, and takes the one that most improves its star's worst
 // element. Vertices in id order, passes until none moves. Returns the moves made.
+// A tetrahedron's vertices in frame coordinates, and pointers to them.
+void ElementFrame(const Smoother& s, std::int64_t e, V3* frame, const V3** v)
+{
+  const std::int64_t* cell = s.Topology.Cell(e);
+  for (int k = 0; k < 4; ++k)
+  {
+    frame[k] = s.Topology.Geometry().IndexToFrame(s.Points[cell[k]]);
+    v[k] = &frame[k];
+  }
+}
+
+// One free vertex of a sliver: the best of short steps (1/4, 1/8, 1/16 of its shortest edge) along
+// the slivers' opposite-face normals and the axes, taken when it raises its star's quality; true
+// when the vertex moved.
+bool PerturbVertex(Smoother& s, std::int64_t vertex, double threshold)
+{
+  const ImageGeometry& g = s.Topology.Geometry();
+  const CompressedRows& stars = s.Topology.Stars();
+  const std::int64_t* star = stars.Begin(vertex);
+  const std::int64_t size = stars.Size(vertex);
+  const V3 from = s.Points[vertex];
+  const V3 at = g.IndexToFrame(from);
+  // Directions (frame coordinates): the slivers' opposite-face normals, then the axes.
+  std::vector<V3> directions;
+  double shortest = 1e300;
+  for (std::int64_t k = 0; k < size; ++k)
+  {
+    V3 frame[4];
+    const V3* v[4];
+    ElementFrame(s, star[k], frame, v);
+    const std::int64_t* cell = s.Topology.Cell(star[k]);
+    for (int l = 0; l < 4; ++l)
+    {
+      if (cell[l] != vertex)
+      {
+        const V3 d = Sub(frame[l], at);
+        shortest = std::min(shortest, std::sqrt(Dot(d, d)));
+      }
+    }
+    if (AngleScore(v, 4) >= threshold)
+    {
+      continue;
+    }
+    const int self = cell[0] == vertex ? 0 : (cell[1] == vertex ? 1 : (cell[2] == vertex ? 2 : 3));
+    V3 n = Cross(Sub(frame[(self + 2) % 4], frame[(self + 1) % 4]), Sub(frame[(self + 3) % 4], frame[(self + 1) % 4]));
+    if (Dot(n, Sub(at, frame[(self + 1) % 4])) < 0)
+    {
+      n = { { -n[0], -n[1], -n[2] } };
+    }
+    const double length = std::sqrt(Dot(n, n));
+    if (length > 0.0)
+    {
+      directions.push_back({ { n[0] / length, n[1] / length, n[2] / length } });
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    for (const double sign : { 1.0, -1.0 })
+    {
+      V3 d = { { 0, 0, 0 } };
+      d[a] = sign;
+      directions.push_back(d);
+    }
+  }
+  double best = s.StarQuality(star, size, -1, from);
+  V3 bestAt = from;
+  for (const double fraction : { 0.25, 0.125, 0.0625 })
+  {
+    for (const V3& d : directions)
+    {
+      V3 to = from;
+      for (int a = 0; a < 3; ++a)
+      {
+        to[a] += fraction * shortest * d[a] / std::fabs(g.Spacing[a]);
+      }
+      to = s.Constrain(vertex, to);
+      if (to == from)
+      {
+        continue;
+      }
+      // Only a star better than the best so far counts.
+      const double q = s.StarQuality(star, size, vertex, to, std::nextafter(best, 2.0));
+      if (q > best)
+      {
+        best = q;
+        bestAt = to;
+      }
+    }
+  }
+  if (bestAt == from)
+  {
+    return false;
+  }
+  s.Points[vertex] = bestAt;
+  return true;
+}
+
 std::int64_t PerturbSlivers(Smoother& s, double sliverAngle, int passes, const ParallelFor& parallel, const ProgressFunction& progress,
   bool& aborted)
 {
-  const ImageGeometry& g = s.Topology.Geometry();
   const std::int64_t m = s.Topology.NumberOfElements();
   const std::int64_t nPts = static_cast<std::int64_t>(s.Points.size());
   const CompressedRows& stars = s.Topology.Stars();
   const double threshold = -std::cos(sliverAngle * 3.14159265358979323846 / 180.0);
-  auto frameOf = [&](std::int64_t e, V3* frame, const V3** v) {
-    const std::int64_t* cell = s.Topology.Cell(e);
-    for (int k = 0; k < 4; ++k)
-    {
-      frame[k] = g.IndexToFrame(s.Points[cell[k]]);
-      v[k] = &frame[k];
-    }
-  };
   // Sliver flags per element, kept current: only the stars of moved vertices change.
   auto isSliver = [&](std::int64_t e) {
     V3 frame[4];
     const V3* v[4];
-    frameOf(e, frame, v);
+    ElementFrame(s, e, frame, v);
     return AngleScore(v, 4) < threshold;
   };
   std::vector<std::uint8_t> sliver(m);
@@ -491,84 +579,8 @@ std::int64_t PerturbSlivers(Smoother& s, double sliverAngle, int passes, const P
         aborted = true;
         return moved;
       }
-      if (!candidate[vertex] || !s.Free[vertex])
+      if (candidate[vertex] && s.Free[vertex] && PerturbVertex(s, vertex, threshold))
       {
-        continue;
-      }
-      const std::int64_t* star = stars.Begin(vertex);
-      const std::int64_t size = stars.Size(vertex);
-      const V3 from = s.Points[vertex];
-      const V3 at = g.IndexToFrame(from);
-      // Directions (frame coordinates): the slivers' opposite-face normals, then the axes.
-      std::vector<V3> directions;
-      double shortest = 1e300;
-      for (std::int64_t k = 0; k < size; ++k)
-      {
-        V3 frame[4];
-        const V3* v[4];
-        frameOf(star[k], frame, v);
-        const std::int64_t* cell = s.Topology.Cell(star[k]);
-        for (int l = 0; l < 4; ++l)
-        {
-          if (cell[l] != vertex)
-          {
-            const V3 d = Sub(frame[l], at);
-            shortest = std::min(shortest, std::sqrt(Dot(d, d)));
-          }
-        }
-        if (AngleScore(v, 4) >= threshold)
-        {
-          continue;
-        }
-        const int self = cell[0] == vertex ? 0 : (cell[1] == vertex ? 1 : (cell[2] == vertex ? 2 : 3));
-        V3 n = Cross(Sub(frame[(self + 2) % 4], frame[(self + 1) % 4]), Sub(frame[(self + 3) % 4], frame[(self + 1) % 4]));
-        if (Dot(n, Sub(at, frame[(self + 1) % 4])) < 0)
-        {
-          n = { { -n[0], -n[1], -n[2] } };
-        }
-        const double length = std::sqrt(Dot(n, n));
-        if (length > 0.0)
-        {
-          directions.push_back({ { n[0] / length, n[1] / length, n[2] / length } });
-        }
-      }
-      for (int a = 0; a < 3; ++a)
-      {
-        for (const double sign : { 1.0, -1.0 })
-        {
-          V3 d = { { 0, 0, 0 } };
-          d[a] = sign;
-          directions.push_back(d);
-        }
-      }
-      double best = s.StarQuality(star, size, -1, from);
-      V3 bestAt = from;
-      for (const double fraction : { 0.25, 0.125, 0.0625 })
-      {
-        for (const V3& d : directions)
-        {
-          V3 to = from;
-          for (int a = 0; a < 3; ++a)
-          {
-            to[a] += fraction * shortest * d[a] / std::fabs(g.Spacing[a]);
-          }
-          to = s.Constrain(vertex, to);
-          if (to == from)
-          {
-            continue;
-          }
-          // Only a star better than the best so far counts.
-          const double q = s.StarQuality(star, size, vertex, to, std::nextafter(best, 2.0));
-          if (q > best)
-          {
-            best = q;
-            bestAt = to;
-          }
-        }
-      }
-      if (bestAt != from)
-      {
-        s.Points[vertex] = bestAt;
         movedVertices.push_back(vertex);
         ++movedThisPass;
       }
