@@ -341,6 +341,55 @@ void PlaceUniformNodes(const ImageGeometry& g, int spacing, int h, const std::ve
     }
   }
 }
+// Step 4: halftone points of the Hessian feature map (seed-aware: fading away from the edges that
+// matter), kept out of the exclusion window of every edge. The Canny-scale image `f` and `work` are
+// spent buffers reused for the map. False when progress asked to abort.
+bool PlaceHalftoneNodes(const float* image, float* f, float* work, const ImageGeometry& g, const FeatureNodeParameters& p,
+  double featureFloor, const std::vector<float>& fromEdges, const std::vector<std::uint8_t>& allCanny,
+  const ParallelFor& parallel, const ProgressFunction& progress, FeatureNodeResult& out, NodePlacer& nodes)
+{
+  auto t0 = Clock::now();
+  const float* fh = f;
+  float* rho = work;
+  if (p.HessianSigma != p.GaussianSigma)
+  {
+    // The gradient magnitude and the Canny-scale image are spent: reuse both buffers.
+    GaussianSmooth(image, work, g, p.HessianSigma, parallel);
+    fh = work;
+    rho = f;
+  }
+  HessianFeatureMap(fh, g, p.HalftoneGamma, p.FeaturePercentile, parallel, rho, &out.FeatureMaximum, featureFloor, p.HessianSigma);
+  if (!fromEdges.empty())
+  {
+    // The thesis's density within s of the edges that matter, a Gaussian falloff beyond.
+    const double s = p.UniformSpacing;
+    parallel(g.Size(), 1 << 16, [&](std::int64_t b, std::int64_t e) {
+      for (std::int64_t i = b; i < e; ++i)
+      {
+        const double x = std::max(0.0, fromEdges[i] - s) / s;
+        rho[i] *= static_cast<float>(std::exp(-x * x));
+      }
+    });
+  }
+  out.StepSeconds.emplace_back("hessian", SecondsSince(t0));
+  if (!progress(0.8))
+  {
+    return false;
+  }
+  t0 = Clock::now();
+  const int h = p.ExclusionWindow / 2;
+  for (std::int64_t d : Halftone(rho, g, p.HalftoneThreshold))
+  {
+    int i, j, k;
+    Coordinates(g, d, i, j, k);
+    if (!AnyInBox(out.EdgeMap, g, i, j, k, h) && (allCanny.empty() || !AnyInBox(allCanny, g, i, j, k, h)))
+    {
+      nodes.Add(i, j, k, NodeType::Halftone, static_cast<float>(h));
+    }
+  }
+  out.StepSeconds.emplace_back("halftone", SecondsSince(t0));
+  return true;
+}
 } // namespace
 
 FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* edgeInput, const ImageGeometry& g,
@@ -452,49 +501,10 @@ FeatureNodeResult ComputeFeatureNodes(const float* image, const std::uint8_t* ed
 
   // 4. Halftoning points, away from edges.
   const int h = p.ExclusionWindow / 2;
-  if (p.Halftoning)
+  if (p.Halftoning && !PlaceHalftoneNodes(image, f, work, g, p, floors.Feature, fromEdges, allCanny, parallel, progress, out, nodes))
   {
-    t0 = Clock::now();
-    const float* fh = f;
-    float* rho = work;
-    if (p.HessianSigma != p.GaussianSigma)
-    {
-      // The gradient magnitude and the Canny-scale image are spent: reuse both buffers.
-      GaussianSmooth(image, work, g, p.HessianSigma, parallel);
-      fh = work;
-      rho = f;
-    }
-    HessianFeatureMap(fh, g, p.HalftoneGamma, p.FeaturePercentile, parallel, rho, &out.FeatureMaximum, floors.Feature,
-      p.HessianSigma);
-    if (seedAware)
-    {
-      // The thesis's density within s of the edges that matter, a Gaussian falloff beyond.
-      const double s = p.UniformSpacing;
-      parallel(n, 1 << 16, [&](std::int64_t b, std::int64_t e) {
-        for (std::int64_t i = b; i < e; ++i)
-        {
-          const double x = std::max(0.0, fromEdges[i] - s) / s;
-          rho[i] *= static_cast<float>(std::exp(-x * x));
-        }
-      });
-    }
-    out.StepSeconds.emplace_back("hessian", SecondsSince(t0));
-    if (!progress(0.8))
-    {
-      out.Aborted = true;
-      return out;
-    }
-    t0 = Clock::now();
-    for (std::int64_t d : Halftone(rho, g, p.HalftoneThreshold))
-    {
-      int i, j, k;
-      Coordinates(g, d, i, j, k);
-      if (!AnyInBox(out.EdgeMap, g, i, j, k, h) && (allCanny.empty() || !AnyInBox(allCanny, g, i, j, k, h)))
-      {
-        nodes.Add(i, j, k, NodeType::Halftone, static_cast<float>(h));
-      }
-    }
-    out.StepSeconds.emplace_back("halftone", SecondsSince(t0));
+    out.Aborted = true;
+    return out;
   }
 
   // 5. Uniform lattice points.

@@ -410,6 +410,14 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
   const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
   const GraphEdges& edges = pr.Edges;
   const std::int64_t m = edges.Size();
+  if (n == 0)
+  {
+    return "the graph is empty.";
+  }
+  if (n > static_cast<std::int64_t>(2000000000) || 2 * m > static_cast<std::int64_t>(2000000000))
+  {
+    return "the graph is too large for the max-flow library (node ids are 32-bit).";
+  }
   const auto& dims = edges.GridDims();
   if ((!pr.Size.empty() && static_cast<std::int64_t>(pr.Size.size()) != n) ||
     static_cast<std::int64_t>(pr.Hard.size()) != n || edges.Malformed() ||
@@ -880,11 +888,16 @@ bool RegionCosts(const CutProblem& pr, const HistogramBins& bin, const BinCosts&
   return true;
 }
 
-// Step 5: the seeds' spatial term added to the region costs; it moves terminal capacities only, so
-// a kept flow still applies. False when progress asked to abort.
+// Step 5: the seeds' spatial term (when its weight is positive) added to the region costs; it moves
+// terminal capacities only, so a kept flow still applies. False when progress asked to abort.
 bool AddSeedGeodesicTerm(const CutProblem& pr, double range, SeedGeodesicCache* kept, double* regionObject,
-  double* regionBackground, const ProgressFunction& progress)
+  double* regionBackground, const ProgressFunction& progress, double& seconds)
 {
+  if (!(pr.Geodesic.Weight > 0.0))
+  {
+    return true;
+  }
+  const auto t0 = Clock::now();
   GeodesicGraph graph;
   graph.Edges = &pr.Edges;
   graph.Value = pr.Value.data();
@@ -901,6 +914,7 @@ bool AddSeedGeodesicTerm(const CutProblem& pr, double range, SeedGeodesicCache* 
     regionObject[p] += size * spatialObject[p];
     regionBackground[p] += size * spatialBackground[p];
   }
+  seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return true;
 }
 
@@ -959,6 +973,62 @@ std::shared_ptr<Flow> NewFlowGraph(const GraphEdges& edges, const double* weight
     [&](double t) { return progress(0.6 + 0.4 * t); });
   return done ? g : nullptr;
 }
+// Step 7: the max-flow and each node's side (1 source = object). It has no progress or abort of its
+// own: it runs on its own thread, owning the graph. False when progress asked to abort.
+bool MaxFlow(const std::shared_ptr<Flow>& g, std::int64_t n, bool reuse, const ProgressFunction& progress,
+  std::pair<double, std::vector<std::uint8_t>>& flow)
+{
+  using FlowResult = std::pair<double, std::vector<std::uint8_t>>;
+  return RunWithHeartbeat<FlowResult>(
+    [g, n, reuse]() {
+      FlowResult f;
+      f.first = g->maxflow(reuse);
+      f.second.resize(n);
+      for (std::int64_t p = 0; p < n; ++p)
+      {
+        f.second[p] = g->what_segment(static_cast<int>(p)) == Flow::SOURCE ? 1 : 0;
+      }
+      return f;
+    },
+    progress, flow);
+}
+
+// Step 8: a new record of the graph a re-cut may reuse. Held edge lists and the weights are kept as
+// they are; lists only viewed are copied.
+std::shared_ptr<MaxFlowCache::Kept> NewKept(
+  const CutProblem& pr, double sigmaParameter, double sigma, double weightTotal, std::unique_ptr<double[]> weight)
+{
+  const GraphEdges& edges = pr.Edges;
+  const std::int64_t m = edges.Size();
+  auto kept = std::make_shared<MaxFlowCache::Kept>();
+  kept->Edges = edges.IsGrid() || edges.Held() ? edges
+                                               : GraphEdges::Owned(std::vector<std::int64_t>(edges.First(), edges.First() + m),
+                                                   std::vector<std::int64_t>(edges.Second(), edges.Second() + m));
+  kept->Value = pr.Value;
+  kept->Contact = pr.Contact;
+  kept->SigmaParameter = sigmaParameter;
+  kept->Sigma = sigma;
+  kept->WeightTotal = weightTotal;
+  kept->Weight = std::move(weight);
+  return kept;
+}
+// Step 5b: lambda times both region costs, and K's share of them (the larger per node) added to
+// `total`. False when progress asked to abort.
+bool ScaleRegionCosts(double lambda, std::int64_t n, double* regionObject, double* regionBackground, double& total,
+  const ProgressFunction& progress)
+{
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    regionObject[p] *= lambda;
+    regionBackground[p] *= lambda;
+    total += std::max(regionObject[p], regionBackground[p]);
+    if (!KeepGoing(progress, p, n, 0.0, 1.0))
+    {
+      return false;
+    }
+  }
+  return true;
+}
 } // namespace
 
 CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par, const ProgressFunction& progress,
@@ -969,16 +1039,6 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
   const GraphEdges& edges = pr.Edges;
   const std::int64_t m = edges.Size();
-  if (n == 0)
-  {
-    r.Error = "the graph is empty.";
-    return r;
-  }
-  if (n > static_cast<std::int64_t>(2000000000) || 2 * m > static_cast<std::int64_t>(2000000000))
-  {
-    r.Error = "the graph is too large for the max-flow library (node ids are 32-bit).";
-    return r;
-  }
   r.Error = ValidateProblem(pr, SubProgress(progress, 0.0, 0.05), r.Aborted);
   if (!r.Error.empty() || r.Aborted)
   {
@@ -1032,31 +1092,11 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   AdviseHugePages(regionObject.get(), n * sizeof(double));
   AdviseHugePages(regionBackground.get(), n * sizeof(double));
   if (aborted(RegionCosts(pr, bin, costs, low, width, cache ? &cache->Binned : nullptr, regionObject.get(),
-        regionBackground.get(), SubProgress(progress, 0.2, 0.3))))
-  {
-    return r;
-  }
-  if (pr.Geodesic.Weight > 0.0)
-  {
-    const auto g0 = Clock::now();
-    if (aborted(AddSeedGeodesicTerm(pr, high - low, cache ? &cache->Geodesic : nullptr, regionObject.get(),
-          regionBackground.get(), SubProgress(progress, 0.3, 0.33))))
-    {
-      return r;
-    }
-    r.GeodesicSeconds = std::chrono::duration<double>(Clock::now() - g0).count();
-  }
-  for (std::int64_t p = 0; p < n; ++p)
-  {
-    regionObject[p] *= par.Lambda;
-    regionBackground[p] *= par.Lambda;
-    total += std::max(regionObject[p], regionBackground[p]);
-    if (aborted(KeepGoing(progress, p, n, 0.33, 0.35)))
-    {
-      return r;
-    }
-  }
-  if (aborted(progress(0.35)))
+        regionBackground.get(), SubProgress(progress, 0.2, 0.3))) ||
+    aborted(AddSeedGeodesicTerm(pr, high - low, cache ? &cache->Geodesic : nullptr, regionObject.get(), regionBackground.get(),
+      SubProgress(progress, 0.3, 0.33), r.GeodesicSeconds)) ||
+    aborted(ScaleRegionCosts(par.Lambda, n, regionObject.get(), regionBackground.get(), total, SubProgress(progress, 0.33, 0.35))) ||
+    aborted(progress(0.35)))
   {
     return r;
   }
@@ -1078,15 +1118,14 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   std::shared_ptr<Flow> g;
   try
   {
+    g = reuse ? kept->Graph : NewFlowGraph(edges, weight, n, source, sink, SubProgress(progress, 0.35, 0.5));
+    if (aborted(g != nullptr))
+    {
+      return r;
+    }
     if (reuse)
     {
-      g = kept->Graph;
       UpdateTerminals(*g, *kept, n, source, sink);
-    }
-    else if (!(g = NewFlowGraph(edges, weight, n, source, sink, SubProgress(progress, 0.35, 0.5))))
-    {
-      r.Aborted = true;
-      return r;
     }
   }
   catch (const std::exception&)
@@ -1096,24 +1135,11 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   }
   const auto t1 = Clock::now();
   r.GraphSeconds = std::chrono::duration<double>(t1 - t0).count();
-  // 7. The max-flow has no progress or abort of its own: it runs on its own thread, owning the graph.
-  using FlowResult = std::pair<double, std::vector<std::uint8_t>>;
-  FlowResult flow;
+  // 7. The max-flow, on its own thread.
+  std::pair<double, std::vector<std::uint8_t>> flow;
   try
   {
-    const bool done = RunWithHeartbeat<FlowResult>(
-      [g, n, reuse]() {
-        FlowResult f;
-        f.first = g->maxflow(reuse);
-        f.second.resize(n);
-        for (std::int64_t p = 0; p < n; ++p)
-        {
-          f.second[p] = g->what_segment(static_cast<int>(p)) == Flow::SOURCE ? 1 : 0;
-        }
-        return f;
-      },
-      SubProgress(progress, 0.5, 1.0), flow);
-    if (aborted(done))
+    if (aborted(MaxFlow(g, n, reuse, SubProgress(progress, 0.5, 1.0), flow)))
     {
       return r;
     }
@@ -1130,18 +1156,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   {
     if (!reuse)
     {
-      kept = std::make_shared<MaxFlowCache::Kept>();
-      // Held lists and the weights are kept as they are; lists only viewed are copied.
-      kept->Edges = edges.IsGrid() || edges.Held()
-        ? edges
-        : GraphEdges::Owned(std::vector<std::int64_t>(edges.First(), edges.First() + m),
-            std::vector<std::int64_t>(edges.Second(), edges.Second() + m));
-      kept->Value = pr.Value;
-      kept->Contact = pr.Contact;
-      kept->SigmaParameter = par.Sigma;
-      kept->Sigma = r.Sigma;
-      kept->WeightTotal = total;
-      kept->Weight = std::move(boundary.Weight);
+      kept = NewKept(pr, par.Sigma, r.Sigma, total, std::move(boundary.Weight));
     }
     kept->Graph = g;
     kept->Source.resize(n);
