@@ -84,6 +84,193 @@ double PottsEnergy(const PottsProblem& pr, const std::vector<std::uint8_t>& labe
   return e;
 }
 
+namespace
+{
+std::int16_t HardLabel(const PottsProblem& pr, std::int64_t p)
+{
+  return pr.Hard.empty() ? -1 : pr.Hard[p];
+}
+
+// The labelling the moves start from: `label` when it has one label per node (a kept result), else
+// each node's cheapest label; hard nodes take their own, a label out of range 0.
+void StartLabels(const PottsProblem& pr, std::vector<std::uint8_t>& label)
+{
+  const std::int64_t n = pr.Nodes;
+  const int L = pr.Labels;
+  if (static_cast<std::int64_t>(label.size()) != n)
+  {
+    label.assign(n, 0);
+    for (std::int64_t p = 0; p < n; ++p)
+    {
+      const double* c = &pr.Cost[p * L];
+      label[p] = static_cast<std::uint8_t>(HardLabel(pr, p) >= 0 ? HardLabel(pr, p) : std::min_element(c, c + L) - c);
+    }
+  }
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    const std::int16_t h = HardLabel(pr, p);
+    if (label[p] >= L || (h >= 0 && label[p] != h))
+    {
+      label[p] = static_cast<std::uint8_t>(h >= 0 ? h : 0);
+    }
+  }
+}
+
+// A bound on the energy of any labelling: finite costs and weights whose sum overflows are an error.
+double EnergyBound(const PottsProblem& pr)
+{
+  double K = 1.0;
+  for (std::int64_t p = 0; p < pr.Nodes; ++p)
+  {
+    const double* c = &pr.Cost[p * pr.Labels];
+    K += std::fabs(*std::max_element(c, c + pr.Labels)) + std::fabs(*std::min_element(c, c + pr.Labels));
+  }
+  for (double w : pr.Weight)
+  {
+    K += w;
+  }
+  return K;
+}
+
+// Each node's summed boundary weight (Reach: the most a move's pairwise terms can reward it for
+// switching), and its neighbours with the edges' weights in compressed rows (First), to price a
+// move by the nodes it moved.
+struct Neighbourhood
+{
+  std::vector<double> Reach, Weight;
+  std::vector<std::int64_t> First, Neighbour;
+  explicit Neighbourhood(const PottsProblem& pr)
+    : Reach(pr.Nodes, 0.0)
+    , First(pr.Nodes + 1, 0)
+  {
+    const std::int64_t n = pr.Nodes;
+    pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
+      this->Reach[p] += pr.Weight[k];
+      this->Reach[q] += pr.Weight[k];
+      ++this->First[p + 1];
+      ++this->First[q + 1];
+    });
+    for (std::int64_t p = 0; p < n; ++p)
+    {
+      this->First[p + 1] += this->First[p];
+    }
+    this->Neighbour.resize(this->First[n]);
+    this->Weight.resize(this->First[n]);
+    std::vector<std::int64_t> at(this->First.begin(), this->First.end() - 1);
+    pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
+      this->Neighbour[at[p]] = q;
+      this->Weight[at[p]++] = pr.Weight[k];
+      this->Neighbour[at[q]] = p;
+      this->Weight[at[q]++] = pr.Weight[k];
+    });
+  }
+};
+
+// One alpha-expansion move on the graph g (reset here): the nodes it switches to alpha and the
+// energy change. Node p keeps its label and pays keep[p] (source segment), or takes alpha and pays
+// take[p] (sink). Fixed, and left out of the graph: nodes at alpha, hard nodes of another label, and
+// nodes whose cost of alpha exceeds their cost of keeping by at least their summed boundary weight
+// (no neighbours can make switching pay, so keeping is optimal: the move stays exact).
+struct MoveBuffers
+{
+  std::vector<double> Keep, Take;
+  std::vector<std::int32_t> Id; // a node's id in the move's graph, -1 when it is fixed
+};
+double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::uint8_t>& label, const Neighbourhood& around,
+  Flow& g, MoveBuffers& buffers, std::vector<std::int64_t>& switched)
+{
+  const std::int64_t n = pr.Nodes;
+  const int L = pr.Labels;
+  std::vector<double>& keep = buffers.Keep;
+  std::vector<double>& take = buffers.Take;
+  std::vector<std::int32_t>& id = buffers.Id;
+  keep.resize(n);
+  take.resize(n);
+  id.resize(n);
+  std::int32_t active = 0;
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    const double* c = &pr.Cost[p * L];
+    keep[p] = take[p] = 0.0;
+    id[p] = -1;
+    if (label[p] != alpha && HardLabel(pr, p) < 0 && c[alpha] - c[label[p]] < around.Reach[p])
+    {
+      keep[p] = c[label[p]];
+      take[p] = c[alpha];
+      id[p] = active++;
+    }
+  }
+  switched.clear();
+  if (active == 0)
+  {
+    return 0.0;
+  }
+  g.reset();
+  g.add_node(active);
+  pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
+    const double w = pr.Weight[k];
+    const int a = label[p], b = label[q];
+    if (w == 0.0 || (id[p] < 0 && id[q] < 0))
+    {
+      return;
+    }
+    if (id[p] < 0 || id[q] < 0)
+    {
+      // One end fixed at its label f: the other pays w when its choice differs from f.
+      const std::int64_t x = id[p] < 0 ? q : p;
+      const int f = id[p] < 0 ? a : b;
+      const int own = id[p] < 0 ? b : a;
+      keep[x] += own != f ? w : 0.0;
+      take[x] += alpha != f ? w : 0.0;
+    }
+    else if (a == b)
+    {
+      g.add_edge(id[p], id[q], w, w);
+    }
+    else
+    {
+      // Keep/keep pays w (a != b), keep/alpha w, alpha/keep w, alpha/alpha 0.
+      keep[q] += w;
+      g.add_edge(id[p], id[q], w, 0.0);
+    }
+  });
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    if (id[p] >= 0)
+    {
+      const double low = std::min(keep[p], take[p]);
+      g.add_tweights(id[p], take[p] - low, keep[p] - low);
+    }
+  }
+  g.maxflow();
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    if (id[p] >= 0 && g.what_segment(id[p]) == Flow::SINK)
+    {
+      switched.push_back(p);
+    }
+  }
+  // The move's energy change, from the nodes it switched and their edges (an edge between two
+  // switched nodes counted once).
+  double change = 0.0;
+  for (const std::int64_t p : switched)
+  {
+    change += pr.Cost[p * L + alpha] - pr.Cost[p * L + label[p]];
+    for (std::int64_t j = around.First[p]; j < around.First[p + 1]; ++j)
+    {
+      const std::int64_t q = around.Neighbour[j];
+      const bool both = id[q] >= 0 && g.what_segment(id[q]) == Flow::SINK;
+      if (both && q < p)
+      {
+        continue;
+      }
+      change += around.Weight[j] * ((both ? 0 : alpha != label[q]) - (label[p] != label[q] ? 1.0 : 0.0));
+    }
+  }
+  return change;
+}
+} // namespace
+
 ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t> label, const ProgressFunction& progress,
   int maxCycles)
 {
@@ -95,73 +282,21 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
   }
   const std::int64_t n = pr.Nodes;
   const int L = pr.Labels;
-  auto hard = [&](std::int64_t p) { return pr.Hard.empty() ? -1 : pr.Hard[p]; };
-  if (static_cast<std::int64_t>(label.size()) != n)
-  {
-    label.assign(n, 0);
-    for (std::int64_t p = 0; p < n; ++p)
-    {
-      const double* c = &pr.Cost[p * L];
-      label[p] = static_cast<std::uint8_t>(hard(p) >= 0 ? hard(p) : std::min_element(c, c + L) - c);
-    }
-  }
-  for (std::int64_t p = 0; p < n; ++p)
-  {
-    if (label[p] >= L || (hard(p) >= 0 && label[p] != hard(p)))
-    {
-      label[p] = static_cast<std::uint8_t>(hard(p) >= 0 ? hard(p) : 0);
-    }
-  }
-  // The energy of any labelling stays below K: finite costs and weights whose sum overflows are an error.
-  double K = 1.0;
-  for (std::int64_t p = 0; p < n; ++p)
-  {
-    const double* c = &pr.Cost[p * L];
-    K += std::fabs(*std::max_element(c, c + L)) + std::fabs(*std::min_element(c, c + L));
-  }
-  for (double w : pr.Weight)
-  {
-    K += w;
-  }
-  if (!std::isfinite(K))
+  StartLabels(pr, label);
+  if (!std::isfinite(EnergyBound(pr)))
   {
     r.Error = "the energy overflows (lambda or the graph are too large); lower lambda.";
     return r;
   }
-  const GraphEdges& edges = *pr.Edges;
-  const std::int64_t m = edges.Size();
+  const std::int64_t m = pr.Edges->Size();
   double energy = PottsEnergy(pr, label);
-  // Each node's summed boundary weight: the most a move's pairwise terms can reward it for switching.
-  std::vector<double> reach(n, 0.0);
-  // And its neighbours with the edges' weights (compressed rows), to price a move by the nodes it moved.
-  std::vector<std::int64_t> first(n + 1, 0);
-  edges.ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
-    reach[p] += pr.Weight[k];
-    reach[q] += pr.Weight[k];
-    ++first[p + 1];
-    ++first[q + 1];
-  });
-  for (std::int64_t p = 0; p < n; ++p)
-  {
-    first[p + 1] += first[p];
-  }
-  std::vector<std::int64_t> neighbour(first[n]);
-  std::vector<double> weight(first[n]);
-  {
-    std::vector<std::int64_t> at(first.begin(), first.end() - 1);
-    edges.ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
-      neighbour[at[p]] = q;
-      weight[at[p]++] = pr.Weight[k];
-      neighbour[at[q]] = p;
-      weight[at[q]++] = pr.Weight[k];
-    });
-  }
-  std::vector<double> keep(n), take(n);
-  std::vector<std::int32_t> id(n); // a node's id in the move's graph, -1 when it is fixed
+  const Neighbourhood around(pr);
   try
   {
     Flow g(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory);
     const int total = std::max(1, maxCycles) * L;
+    std::vector<std::int64_t> switched;
+    MoveBuffers buffers;
     // Done when every label's move has been tried since the last move that lowered the energy.
     int sinceLowered = 0;
     for (r.Cycles = 0; r.Cycles < std::max(1, maxCycles) && sinceLowered < L;)
@@ -174,91 +309,8 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
           r.Aborted = true;
           return r;
         }
-        // Node p keeps its label and pays keep[p] (source segment), or takes alpha and pays take[p]
-        // (sink). Fixed, and left out of the graph: nodes at alpha, hard nodes of another label, and
-        // nodes whose cost of alpha exceeds their cost of keeping by at least their summed boundary
-        // weight (no neighbours can make switching pay, so keeping is optimal: the move stays exact).
-        std::int32_t active = 0;
-        for (std::int64_t p = 0; p < n; ++p)
-        {
-          const double* c = &pr.Cost[p * L];
-          keep[p] = take[p] = 0.0;
-          id[p] = -1;
-          if (label[p] != alpha && hard(p) < 0 && c[alpha] - c[label[p]] < reach[p])
-          {
-            keep[p] = c[label[p]];
-            take[p] = c[alpha];
-            id[p] = active++;
-          }
-        }
-        if (active == 0)
-        {
-          continue;
-        }
-        g.reset();
-        g.add_node(active);
-        edges.ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
-          const double w = pr.Weight[k];
-          const int a = label[p], b = label[q];
-          if (w == 0.0 || (id[p] < 0 && id[q] < 0))
-          {
-            return;
-          }
-          if (id[p] < 0 || id[q] < 0)
-          {
-            // One end fixed at its label f: the other pays w when its choice differs from f.
-            const std::int64_t x = id[p] < 0 ? q : p;
-            const int f = id[p] < 0 ? a : b;
-            const int own = id[p] < 0 ? b : a;
-            keep[x] += own != f ? w : 0.0;
-            take[x] += alpha != f ? w : 0.0;
-          }
-          else if (a == b)
-          {
-            g.add_edge(id[p], id[q], w, w);
-          }
-          else
-          {
-            // Keep/keep pays w (a != b), keep/alpha w, alpha/keep w, alpha/alpha 0.
-            keep[q] += w;
-            g.add_edge(id[p], id[q], w, 0.0);
-          }
-        });
-        for (std::int64_t p = 0; p < n; ++p)
-        {
-          if (id[p] >= 0)
-          {
-            const double low = std::min(keep[p], take[p]);
-            g.add_tweights(id[p], take[p] - low, keep[p] - low);
-          }
-        }
-        g.maxflow();
-        std::vector<std::int64_t> switched;
-        for (std::int64_t p = 0; p < n; ++p)
-        {
-          if (id[p] >= 0 && g.what_segment(id[p]) == Flow::SINK)
-          {
-            switched.push_back(p);
-          }
-        }
-        // The move's energy change, from the nodes it switched and their edges (an edge between two
-        // switched nodes counted once).
-        double change = 0.0;
-        for (const std::int64_t p : switched)
-        {
-          change += pr.Cost[p * L + alpha] - pr.Cost[p * L + label[p]];
-          for (std::int64_t j = first[p]; j < first[p + 1]; ++j)
-          {
-            const std::int64_t q = neighbour[j];
-            const bool both = id[q] >= 0 && g.what_segment(id[q]) == Flow::SINK;
-            if (both && q < p)
-            {
-              continue;
-            }
-            change += weight[j] * ((both ? 0 : alpha != label[q]) - (label[p] != label[q] ? 1.0 : 0.0));
-          }
-        }
-        if (change < -1e-9 * std::max(1.0, std::fabs(energy)))
+        const double change = ExpansionMove(pr, alpha, label, around, g, buffers, switched);
+        if (!switched.empty() && change < -1e-9 * std::max(1.0, std::fabs(energy)))
         {
           for (const std::int64_t p : switched)
           {
