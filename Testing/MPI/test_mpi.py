@@ -35,8 +35,8 @@ for name in ("nuclei-dsb2018", "liver-ct-totalseg"):
     r = vtkXMLPUnstructuredGridReader()
     r.SetFileName(os.path.join(out, name + "_labelled.pvtu"))
     r.Update()
-    saved = r.GetOutput().GetCellData().GetArray("Label")
-    ft.check(saved is not None and ft.np.array_equal(ft.v2n(saved), ft.array(ft.fetch(cut), "Label", cells=True)),
+    saved = r.GetOutput().GetCellData().GetArray(ft.names.Label)
+    ft.check(saved is not None and ft.np.array_equal(ft.v2n(saved), ft.array(ft.fetch(cut), ft.names.Label, cells=True)),
              "%s: the parallel run's element labels equal the serial run's" % name)
     r = vtkXMLPUnstructuredGridReader()
     r.SetFileName(os.path.join(out, name + "_fem.pvtu"))

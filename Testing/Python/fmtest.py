@@ -7,7 +7,7 @@ import subprocess
 import sys
 
 import featuremesh as fm
-from featuremesh import dice, fetch, np, seeds, v2n  # noqa: F401
+from featuremesh import dice, fetch, names, np, seeds, v2n  # noqa: F401
 
 from paraview.simple import *  # noqa: F401,F403
 import paraview.simple as ps

@@ -39,7 +39,7 @@ def run(case):
 
 if len(sys.argv) > 1:  # child run for the thread-count check
     *_, cut = run(sys.argv[1])
-    print(ft.digest(ft.array(ft.fetch(cut), "Label", cells=True)))
+    print(ft.digest(ft.array(ft.fetch(cut), ft.names.Label, cells=True)))
     sys.exit(0)
 
 for case, (svc_floor, voxel_floor) in FLOORS.items():
@@ -49,7 +49,7 @@ for case, (svc_floor, voxel_floor) in FLOORS.items():
     d, image, truth, so, sb, cut = run(case)
     T = ft.array(ft.fetch(truth))
     labelled = ft.fetch(cut, 0)
-    label = ft.array(labelled, "Label", cells=True)
+    label = ft.array(labelled, ft.names.Label, cells=True)
     L = ft.array(ft.fetch(cut, 2))
     vc = ft.VoxelCut(Input=image, ObjectSeeds=so, BackgroundSeeds=sb, Scalars=["POINTS", ft.fetch(image).GetPointData().GetScalars().GetName()],
                      Task=task(case))
@@ -65,8 +65,8 @@ for case, (svc_floor, voxel_floor) in FLOORS.items():
     shape = im.GetDimensions()[::-1]
     voxel_volume = np.prod([abs(x) for x in im.GetSpacing()[: 2 if shape[0] == 1 else 3]])
     for what, out, labels in (("super-voxel", ft.fetch(cut, 2), L), ("voxel", ft.fetch(vc), V)):
-        count = out.GetFieldData().GetArray("ObjectComponents").GetValue(0)
-        volumes = ft.v2n(out.GetFieldData().GetArray("ObjectComponentVolumes"))
+        count = out.GetFieldData().GetArray(ft.names.ObjectComponents).GetValue(0)
+        volumes = ft.v2n(out.GetFieldData().GetArray(ft.names.ObjectComponentVolumes))
         ft.check(abs(volumes.sum() - labels.sum() * voxel_volume) <= 1e-9 * max(1, volumes.sum()) and len(volumes) == count,
                  "%s: %s cut's %d component volumes sum to its object volume" % (case, what, count))
         if what == "voxel":
@@ -98,7 +98,7 @@ for case, (svc_floor, voxel_floor) in FLOORS.items():
         ft.check(abs(enclosed - tet) <= 1e-6 * tet, "%s: surface encloses the object elements' volume (rel. err %.1e)" % (case, abs(enclosed - tet) / tet))
     digest = ft.digest(label)
     *_, again = run(case)
-    ft.check(ft.digest(ft.array(ft.fetch(again), "Label", cells=True)) == digest, "%s: identical labels across runs" % case)
+    ft.check(ft.digest(ft.array(ft.fetch(again), ft.names.Label, cells=True)) == digest, "%s: identical labels across runs" % case)
     one = ft.run_script_with_backend(__file__, "Sequential", case)
     two = ft.run_script_with_backend(__file__, "STDThread", case)
     ft.check(one == two == digest, "%s: identical labels with 1 and 2 threads" % case)
@@ -122,7 +122,7 @@ for step, change in (("a seed edit", lambda: setattr(edited, "Points", points[3:
     fresh.UpdatePipeline()
     a, b = ft.fetch(kept), ft.fetch(fresh)
     ft.check(a.GetNumberOfCells() == b.GetNumberOfCells() > 0 and
-             ft.np.array_equal(ft.array(a, "Label", cells=True), ft.array(b, "Label", cells=True)) and
+             ft.np.array_equal(ft.array(a, ft.names.Label, cells=True), ft.array(b, ft.names.Label, cells=True)) and
              ft.np.array_equal(ft.fm.labels(kept), ft.fm.labels(fresh)),
              "after %s the kept cut equals a fresh one (%d elements)" % (step, a.GetNumberOfCells()))
     ft.Delete(fresh)
@@ -135,7 +135,7 @@ d, image, truth, so, sb, cut = run("nuclei-dsb2018")
 owner_map = ft.fm.owner_map(cut.Mesh)
 ft.check(owner_map is not None and owner_map.GetNumberOfTuples() == ft.fetch(image).GetNumberOfPoints(),
          "Delaunay Image Mesh keeps a VoxelOwner map of one id per voxel")
-ft.check(all(ft.fetch(p, port).GetFieldData().GetArray("VoxelOwner") is None for p, port in ((cut.Mesh, 0), (cut, 0), (cut, 2))),
+ft.check(all(ft.fetch(p, port).GetFieldData().GetArray(ft.names.VoxelOwner) is None for p, port in ((cut.Mesh, 0), (cut, 0), (cut, 2))),
          "neither the mesh nor the cut's outputs carry the map in their arrays (writers would save it)")
 retyped = ft.ProgrammableFilter(Input=cut.Mesh, OutputDataSetType="vtkUnstructuredGrid", Script="""
 from vtkmodules.vtkCommonCore import vtkPoints, VTK_DOUBLE, VTK_FLOAT
@@ -148,9 +148,9 @@ for i in range(out.GetNumberOfPoints()):
     points.SetPoint(i, out.GetPoint(i))
 out.SetPoints(points)""")
 ids = [ft.SuperVoxelCut(Mesh=m, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, SuperVoxelIds=1) for m in (cut.Mesh, retyped)]
-reused = [ft.fetch(c).GetFieldData().GetArray("OwnerMapReused").GetValue(0) for c in ids]
+reused = [ft.fetch(c).GetFieldData().GetArray(ft.names.OwnerMapReused).GetValue(0) for c in ids]
 ft.check(reused == [1.0, 0.0], "the cut reuses stage 2's map, and rasterises the mesh stored otherwise (%s)" % reused)
-a, b = (ft.array(ft.fetch(c, 2), "ElementId") for c in ids)
+a, b = (ft.array(ft.fetch(c, 2), ft.names.ElementId) for c in ids)
 ft.check(ft.np.array_equal(a, b) and ft.np.array_equal(ft.v2n(owner_map), a),
          "the kept owner map equals the cut's own rasterisation (%d voxels)" % a.size)
 # A mesh whose points moved since (stage 6, a Transform) is rasterised afresh.
@@ -158,7 +158,7 @@ shifted = ft.Transform(Input=cut.Mesh)
 shifted.Transform.Translate = [0.25, 0.0, 0.0]
 fresh = ft.SuperVoxelCut(Mesh=shifted, ObjectSeeds=so, BackgroundSeeds=sb, Image=image)
 fresh.UpdatePipeline()
-ft.check(ft.fetch(fresh).GetFieldData().GetArray("OwnerMapReused").GetValue(0) == 0.0,
+ft.check(ft.fetch(fresh).GetFieldData().GetArray(ft.names.OwnerMapReused).GetValue(0) == 0.0,
          "a moved mesh is rasterised afresh, not given the map of the mesh it came from")
 
 # A chain of seed edits reuses the last max-flow (Kohli-Torr): after each, labels and flow equal a
@@ -185,8 +185,8 @@ for case in ("nuclei-dsb2018", "liver-ct-totalseg"):
         fresh = ft.SuperVoxelCut(Mesh=cut.Mesh, ObjectSeeds=edited, BackgroundSeeds=sb, Image=image)
         fresh.UpdatePipeline()
         a, b = ft.fetch(chained), ft.fetch(fresh)
-        fa, fb = (x.GetFieldData().GetArray("Flow").GetValue(0) for x in (a, b))
-        same += (ft.np.array_equal(ft.array(a, "Label", cells=True), ft.array(b, "Label", cells=True)) and
+        fa, fb = (x.GetFieldData().GetArray(ft.names.Flow).GetValue(0) for x in (a, b))
+        same += (ft.np.array_equal(ft.array(a, ft.names.Label, cells=True), ft.array(b, ft.names.Label, cells=True)) and
                  abs(fa - fb) <= 1e-9 * abs(fb))
         ft.Delete(fresh)
     ft.check(same == len(edits), "%s: %d of %d chained seed edits give a fresh cut's labels and flow" % (case, same, len(edits)))
@@ -208,7 +208,7 @@ ft.check(cells_with(so, so) == 0, "the same elements seeded as both: error")
 empty = ft.PolyPointSource(Points=[])
 ft.check(cells_with(empty, sb) == 0, "no object seeds: error")
 ft.check(cells_with(so, empty) == 0, "only one class of seeds: error")
-bare = ft.PassArrays(Input=mesh, CellDataArrays=["PixelCount"], PointDataArrays=[], FieldDataArrays=[])
+bare = ft.PassArrays(Input=mesh, CellDataArrays=[ft.names.PixelCount], PointDataArrays=[], FieldDataArrays=[])
 ft.check(cells_with(so, sb, bare) == 0, "a mesh without MeanIntensity: error")
 print("all cut checks passed")
 

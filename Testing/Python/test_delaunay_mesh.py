@@ -39,17 +39,17 @@ for case, backends in (("nuclei-dsb2018", [0]), ("liver-ct-totalseg", [0, 1])):
         ug = ft.fetch(mesh)
         P = ft.v2n(ug.GetPoints().GetData())
         C = ft.v2n(ug.GetCells().GetConnectivityArray()).reshape(ug.GetNumberOfCells(), -1)
-        pc = ft.array(ug, "PixelCount", cells=True)
+        pc = ft.array(ug, ft.names.PixelCount, cells=True)
         ft.check(pc.sum() == np.prod(dims), "%s: PixelCount sums to the %d voxels" % (tag, np.prod(dims)))
         m = measures(P, C)
         box = np.prod((np.array(dims) - 1)[: 2 if dims[2] == 1 else 3] * sp[: 2 if dims[2] == 1 else 3])
         ft.check(abs(m.sum() - box) <= 1e-9 * box, "%s: element measures sum to the box (rel. err %.1e)" % (tag, abs(m.sum() - box) / box))
         ft.check(m.min() > 0, "%s: no element of zero or negative measure (min %.3g)" % (tag, m.min()))
         ft.check(np.array_equal(P[: len(node_pts)], node_pts), "%s: every input node is a mesh point, in order" % tag)
-        quality = "MinAngle" if dims[2] == 1 else "MinDihedralAngle"
-        for name in ("MeanIntensity", "IntensityStdDev", "Interpolated", quality, "RadiusRatio"):
+        quality = ft.names.MinAngle if dims[2] == 1 else ft.names.MinDihedralAngle
+        for name in (ft.names.MeanIntensity, ft.names.IntensityStdDev, ft.names.Interpolated, quality, ft.names.RadiusRatio):
             ft.check(ug.GetCellData().GetArray(name) is not None, "%s: cell array %s" % (tag, name))
-        mean = ft.array(ug, "MeanIntensity", cells=True)
+        mean = ft.array(ug, ft.names.MeanIntensity, cells=True)
         checked = ft.brute_force_statistics(P, C, values, dims, sp, pc, mean, rng.choice(len(C), 400, replace=False))
         ft.check(checked >= 50, "%s: MeanIntensity and PixelCount match brute force on %d sampled elements" % (tag, checked))
         # Empty circumcircle / circumsphere on a sample (points on the sphere are allowed: lattice ties).
@@ -95,15 +95,15 @@ for case in ("liver-ct-totalseg", "brain-tumour-brats-0005"):
     nodes = c.feature_nodes()
     plain, refined = c.mesh(nodes), c.mesh(nodes, QualityRefinement=1, MinDihedralAngle=10, RadiusEdgeRatio=2)
     p, r = ft.fetch(plain), ft.fetch(refined)
-    angle = ft.array(r, "MinDihedralAngle", cells=True).min()
+    angle = ft.array(r, ft.names.MinDihedralAngle, cells=True).min()
     added = r.GetNumberOfPoints() - p.GetNumberOfPoints()
     ft.check(angle >= 9.99, "%s: quality refinement reaches a minimum dihedral angle of %.2f deg (plain mesh %.2f deg)" % (
-        case, angle, ft.array(p, "MinDihedralAngle", cells=True).min()))
-    ft.check(added > 0 and r.GetFieldData().GetArray("AddedNodes").GetValue(0) == added, "%s: %d nodes added (%d -> %d)" % (
+        case, angle, ft.array(p, ft.names.MinDihedralAngle, cells=True).min()))
+    ft.check(added > 0 and r.GetFieldData().GetArray(ft.names.AddedNodes).GetValue(0) == added, "%s: %d nodes added (%d -> %d)" % (
         case, added, p.GetNumberOfPoints(), r.GetNumberOfPoints()))
-    ft.check(ft.array(r, "PixelCount", cells=True).sum() == ft.fetch(c.image).GetNumberOfPoints(),
+    ft.check(ft.array(r, ft.names.PixelCount, cells=True).sum() == ft.fetch(c.image).GetNumberOfPoints(),
              "%s: every voxel has one element after refinement" % case)
-    types = ft.array(r, "NodeType")
-    fixed = ft.array(r, "Fixed")
+    types = ft.array(r, ft.names.NodeType)
+    fixed = ft.array(r, ft.names.Fixed)
     ft.check((types[p.GetNumberOfPoints():] == 4).all() and (fixed[p.GetNumberOfPoints():] == 0).all(),
              "%s: added nodes are NodeType 4, not fixed" % case)

@@ -8,12 +8,12 @@ for case in ("nuclei-dsb2018", "liver-ct-totalseg"):
     c = ft.fm.Case(ft.case_dir(case))
     nodes, mesh, cut = c.pipeline()
     smooth = c.smoothing(mesh)
-    quality = "MinDihedralAngle" if c.is3d else "MinAngle"
+    quality = ft.names.MinDihedralAngle if c.is3d else ft.names.MinAngle
     view = ft.ps.CreateRenderView()
     for name, proxy, port, representation, colour in (
             ("Delaunay Image Mesh", mesh, 0, "Surface With Edges", ["CELLS", quality]),
             ("Image Mesh Smoothing", smooth, 0, "Surface With Edges", ["CELLS", quality]),
-            ("Super-Voxel Cut", cut, 0, "Surface With Edges", ["CELLS", "Label"])):
+            ("Super-Voxel Cut", cut, 0, "Surface With Edges", ["CELLS", ft.names.Label])):
         shown = ft.ps.Show(ft.ps.OutputPort(proxy, port), view)
         ft.check(shown.Representation == representation and list(shown.ColorArrayName) == colour,
                  "%s %s: %s coloured by %s (got %s, %s)" % (case, name, representation, colour[1], shown.Representation,
@@ -28,7 +28,7 @@ view = ft.ps.CreateRenderView()
 shown = [controller.ShowInPreferredView(rsp.SMProxy, port, view.SMProxy) is not None for port in range(3)]
 ft.check(shown == [True, False, False], "RSP Edge Enhancement: Apply shows the edge confidence only (%s)" % shown)
 edges = ft.ps.GetDisplayProperties(ft.ps.OutputPort(rsp, 0), view)
-ft.check(list(edges.ColorArrayName) == ["POINTS", "EdgeConfidence"], "RSP: coloured by EdgeConfidence (%s)" % list(edges.ColorArrayName))
+ft.check(list(edges.ColorArrayName) == ["POINTS", ft.names.EdgeConfidence], "RSP: coloured by EdgeConfidence (%s)" % list(edges.ColorArrayName))
 
 def unconnected(xml_name):
     return ft.ps.servermanager.vtkSMProxyManager.GetProxyManager().NewProxy("filters", xml_name)

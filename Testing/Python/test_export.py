@@ -34,7 +34,7 @@ for case in ("nuclei-dsb2018", "liver-ct-totalseg"):
             name = cd.GetArrayName(i)
             ft.check(name in m.cell_data and ft.np.array_equal(m.cell_data[name][0], ft.v2n(cd.GetArray(i))),
                      "%s %s: cell array %s round-trips" % (case, tag, name))
-        ft.check(all(k in m.field_data for k in ("ImageOrigin", "ImageSpacing", "ImageDimensions", "ImageDirection")),
+        ft.check(all(k in m.field_data for k in (ft.names.ImageOrigin, ft.names.ImageSpacing, ft.names.ImageDimensions, ft.names.ImageDirection)),
                  "%s %s: the image frame is in the field data" % (case, tag))
     labels = ft.fetch(cut, 2)
     path = os.path.join(out, "%s_labels.vti" % case)
@@ -55,14 +55,14 @@ path = os.path.join(out, "liver_labels_saved.vti")
 ft.ps.SaveData(path, proxy=ft.ps.OutputPort(cut, 2))
 voxels = ft.fetch(cut, 2).GetNumberOfPoints()
 ft.check(os.path.getsize(path) < 2 * voxels, "the saved label image is %d bytes for %d voxels" % (os.path.getsize(path), voxels))
-ft.check(ft.fetch(cut, 2).GetFieldData().GetArray("VoxelOwner") is None, "the label image carries no VoxelOwner")
+ft.check(ft.fetch(cut, 2).GetFieldData().GetArray(ft.names.VoxelOwner) is None, "the label image carries no VoxelOwner")
 # Nor do the meshes of stages 2 and 3: a saved mesh holds its elements' arrays, not 4 bytes per voxel.
 smooth = c.smoothing(mesh)
 for name, proxy in (("Delaunay Image Mesh", mesh), ("Image Mesh Smoothing", smooth)):
     path = os.path.join(out, "liver_%s.vtu" % name.replace(" ", "_"))
     ft.ps.SaveData(path, proxy=proxy)
     data = ft.fetch(proxy)
-    ft.check(ft.fm.owner_map(proxy) is not None and data.GetFieldData().GetArray("VoxelOwner") is None,
+    ft.check(ft.fm.owner_map(proxy) is not None and data.GetFieldData().GetArray(ft.names.VoxelOwner) is None,
              "%s keeps its owner map off its arrays" % name)
     ft.check(b"VoxelOwner" not in open(path, "rb").read(), "%s: the saved .vtu (%d bytes) holds no owner map (%d bytes)"
              % (name, os.path.getsize(path), 4 * voxels))

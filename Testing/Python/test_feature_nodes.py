@@ -24,7 +24,7 @@ def nodes_of(case, **props):
 
 if len(sys.argv) > 1:  # child run for the thread-count check: print a digest of the nodes
     _, _, pd, _ = nodes_of(sys.argv[1])
-    print(ft.digest(ft.v2n(pd.GetPoints().GetData()), ft.array(pd, "NodeType")))
+    print(ft.digest(ft.v2n(pd.GetPoints().GetData()), ft.array(pd, ft.names.NodeType)))
     sys.exit(0)
 
 for case, (max_fraction, min_ratio) in CASES.items():
@@ -49,10 +49,10 @@ for case, (max_fraction, min_ratio) in CASES.items():
     N[idx[:, 2], idx[:, 1], idx[:, 0]] = True
     ratio = N[dist <= 3].mean() / N[dist > 10].mean()
     ft.check(ratio >= min_ratio, "%s: node density near the reference boundary / far = %.2f (>= %g)" % (case, ratio, min_ratio))
-    for name in ("NodeType", "Fixed", "SampleRadius"):
+    for name in (ft.names.NodeType, ft.names.Fixed, ft.names.SampleRadius):
         ft.check(pd.GetPointData().GetArray(name) is not None, "%s: point array %s" % (case, name))
-    fixed = ft.array(pd, "Fixed")
-    types = ft.array(pd, "NodeType")
+    fixed = ft.array(pd, ft.names.Fixed)
+    types = ft.array(pd, ft.names.NodeType)
     dims = np.array(dims)
     corner = ((idx == 0) | (idx == dims - 1))[:, :(3 if dims[2] > 1 else 2)].all(axis=1)
     ft.check(((fixed == 1) == ((types == 0) | ((types == 3) & corner))).all(),
@@ -60,7 +60,7 @@ for case, (max_fraction, min_ratio) in CASES.items():
     ft.check(corner.sum() == (8 if dims[2] > 1 else 4), "%s: the box corners are nodes" % case)
     ft.check(ft.array(edges).shape[0] == n_vox, "%s: edge map on the image grid" % case)
     _, _, again, _ = nodes_of(case)
-    ft.check(ft.digest(P, types) == ft.digest(ft.v2n(again.GetPoints().GetData()), ft.array(again, "NodeType")), "%s: identical across two runs" % case)
+    ft.check(ft.digest(P, types) == ft.digest(ft.v2n(again.GetPoints().GetData()), ft.array(again, ft.names.NodeType)), "%s: identical across two runs" % case)
     one = ft.run_script_with_backend(__file__, "Sequential", case)
     two = ft.run_script_with_backend(__file__, "STDThread", case)
     ft.check(one == two == ft.digest(P, types), "%s: identical with 1 thread (Sequential) and 2 threads (STDThread)" % case)
@@ -97,7 +97,7 @@ ft.check(node_count(image_source(nan, (64, 64, 1))) == 0, "NaN values: error, em
 ft.check(node_count(image_source(np.zeros((64 * 64, 3), np.float32), (64, 64, 1))) == 0, "RGB array: error, empty output")
 ft.check(node_count(image_source(np.zeros(1, np.float32), (1, 1, 1))) == 0, "1-voxel image: error, empty output")
 const = ft.fetch(ft.FeatureNodes(Input=image_source(np.full((64, 64), 7, np.float32), (64, 64, 1))))
-ct = ft.array(const, "NodeType")
+ct = ft.array(const, ft.names.NodeType)
 ft.check(const.GetNumberOfPoints() > 4 and set(np.unique(ct)) <= {2, 3}, "constant image: uniform and boundary nodes only (with a warning)")
 ft.check(node_count(image_source(good, (64, 64, 1)), GaussianSigma=-1) == 0, "negative sigma: error, empty output")
 ft.check(node_count(image_source(good, (64, 64, 1)), LowThreshold=0.7, HighThreshold=0.6) == 0, "thresholds out of order: error, empty output")

@@ -93,9 +93,9 @@ for case, spacing, frames in (
         vpc = 3 if base.GetDimensions()[2] == 1 else 4
         cells = [np.sort(ft.v2n(m.GetCells().GetConnectivityArray()).reshape(-1, vpc), axis=1) for m in (out["mesh"], ref["mesh"])]
         ft.check(np.array_equal(*cells), "%s: the same elements" % tag)
-        ft.check(np.array_equal(ft.array(out["mesh"], "PixelCount", cells=True), ft.array(ref["mesh"], "PixelCount", cells=True)),
+        ft.check(np.array_equal(ft.array(out["mesh"], ft.names.PixelCount, cells=True), ft.array(ref["mesh"], ft.names.PixelCount, cells=True)),
                  "%s: the same voxel ownership (PixelCount)" % tag)
-        ft.check(np.array_equal(ft.array(out["cut"], "Label", cells=True), ft.array(ref["cut"], "Label", cells=True)),
+        ft.check(np.array_equal(ft.array(out["cut"], ft.names.Label, cells=True), ft.array(ref["cut"], ft.names.Label, cells=True)),
                  "%s: the same element labels" % tag)
         for key in ("labels", "bare", "voxelcut"):
             ft.check(np.array_equal(ft.array(out[key]), ft.array(ref[key])), "%s: the same %s" % (tag, key))

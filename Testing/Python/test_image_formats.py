@@ -57,7 +57,7 @@ def segment(source, scalars, which):
     cut = ft.ps.SuperVoxelCut(Mesh=smooth, ObjectSeeds=so, BackgroundSeeds=sb, Image=source, Scalars=scalars)
     voxel = ft.ps.VoxelCut(Input=source, ObjectSeeds=so, BackgroundSeeds=sb, Scalars=scalars)
     rsp = ft.ps.RSPEdgeEnhancement(Input=source, ObjectSeeds=so, BackgroundSeeds=sb, Scalars=scalars)
-    edges = ft.fetch(rsp).GetPointData().GetArray("EdgeConfidence")
+    edges = ft.fetch(rsp).GetPointData().GetArray(ft.names.EdgeConfidence)
     return ft.fm.labels(cut), ft.fm.labels(voxel, 0), ft.v2n(edges), ft.fetch(smooth).GetNumberOfCells()
 
 

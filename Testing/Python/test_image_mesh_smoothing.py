@@ -26,7 +26,7 @@ def cells(ug):
 
 if len(sys.argv) > 1:  # child run for the thread-count check: a digest of the output
     _, _, ug = smoothed(sys.argv[1])
-    print(ft.digest(ft.v2n(ug.GetPoints().GetData()), cells(ug), ft.array(ug, "MeanIntensity", cells=True)))
+    print(ft.digest(ft.v2n(ug.GetPoints().GetData()), cells(ug), ft.array(ug, ft.names.MeanIntensity, cells=True)))
     sys.exit(0)
 
 for case in CASES:
@@ -44,14 +44,14 @@ for case in CASES:
     box = np.prod((dims - 1)[:k] * sp[:k])
     ft.check(m.min() > 0, "%s: no inverted or zero-measure element (min %.3g)" % (case, m.min()))
     ft.check(abs(m.sum() - box) <= 1e-9 * box, "%s: measures sum to the box (rel. err %.1e)" % (case, abs(m.sum() - box) / box))
-    pc = ft.array(ug, "PixelCount", cells=True)
+    pc = ft.array(ug, ft.names.PixelCount, cells=True)
     ft.check(pc.sum() == np.prod(dims), "%s: PixelCount sums to the %d voxels" % (case, np.prod(dims)))
     values = ft.array(im).astype(float).reshape(dims[::-1])
-    checked = ft.brute_force_statistics(P, C, values, dims, sp, pc, ft.array(ug, "MeanIntensity", cells=True),
+    checked = ft.brute_force_statistics(P, C, values, dims, sp, pc, ft.array(ug, ft.names.MeanIntensity, cells=True),
                                         rng.choice(len(C), 400, replace=False))
     ft.check(checked >= 50, "%s: MeanIntensity and PixelCount match brute force on %d moved elements" % (case, checked))
     # Which nodes moved.
-    fixed = ft.array(before, "Fixed").astype(bool)
+    fixed = ft.array(before, ft.names.Fixed).astype(bool)
     I0, I = P0 / sp, P[:n0] / sp
     # 3D: nodes within 1.5 voxels of the box move onto it before refinement (SnappedNodes).
     near_box = ((I0[:, :k] > 1e-9) & (I0[:, :k] <= 1.5)) | ((I0[:, :k] < dims[:k] - 1 - 1e-9) & (I0[:, :k] >= dims[:k] - 2.5))
@@ -63,8 +63,8 @@ for case in CASES:
     ft.check(landed.all() and (np.abs(I[snapped] - I0[snapped]) <= 1.5 + 1e-9).all(),
              "%s: the %d Fixed nodes that moved moved onto the box, by at most 1.5 voxels" % (case, snapped.sum()))
     if k == 3:
-        ft.check(ug.GetFieldData().GetArray("SnappedNodes").GetValue(0) >= snapped.sum() > 0,
-                 "%s: SnappedNodes counts them (%d)" % (case, ug.GetFieldData().GetArray("SnappedNodes").GetValue(0)))
+        ft.check(ug.GetFieldData().GetArray(ft.names.SnappedNodes).GetValue(0) >= snapped.sum() > 0,
+                 "%s: SnappedNodes counts them (%d)" % (case, ug.GetFieldData().GetArray(ft.names.SnappedNodes).GetValue(0)))
     on_face = (np.abs(I0) < 1e-9) | (np.abs(I0 - (dims - 1)) < 1e-9)
     on_face[:, k:] = False
     ft.check(np.array_equal(I[on_face], I0[on_face]), "%s: box nodes stay on their faces (%d coordinates)" % (case, on_face.sum()))
@@ -72,14 +72,14 @@ for case in CASES:
     ft.check(moved[~fixed].mean() > 0.5, "%s: %.0f %% of the free nodes moved" % (case, 100 * moved[~fixed].mean()))
     ft.check(((I >= -1e-9) & (I <= dims - 1 + 1e-9)).all(), "%s: every node inside the image box" % case)
     # Arrays: node arrays of the input nodes pass through, added nodes are NodeType 4, free.
-    types, fx = ft.array(ug, "NodeType"), ft.array(ug, "Fixed")
-    ft.check(np.array_equal(types[:n0], ft.array(before, "NodeType")) and (types[n0:] == 4).all() and (fx[n0:] == 0).all(),
+    types, fx = ft.array(ug, ft.names.NodeType), ft.array(ug, ft.names.Fixed)
+    ft.check(np.array_equal(types[:n0], ft.array(before, ft.names.NodeType)) and (types[n0:] == 4).all() and (fx[n0:] == 0).all(),
              "%s: node arrays pass through; %d added nodes are NodeType 4, free" % (case, len(P) - n0))
     ft.check(len(P) - n0 <= 0.15 * n0, "%s: %.1f %% nodes added (<= 15 %%)" % (case, 100.0 * (len(P) - n0) / n0))
     # Quality: strictly better minimum, and the goals: 2D 20 deg and 140 deg; 3D 10 deg and 165 deg
     # (the liver's worst stood against the box before its nearby nodes moved onto it).
     q0, q1 = metrics.mesh_quality(P0, C0), metrics.mesh_quality(P, C)
-    name = "MinAngle" if k == 2 else "MinDihedralAngle"
+    name = ft.names.MinAngle if k == 2 else ft.names.MinDihedralAngle
     ft.check(q1["min"] > q0["min"], "%s: minimum angle %.2f -> %.2f deg" % (case, q0["min"], q1["min"]))
     ft.check(abs(ft.array(ug, name, cells=True).min() - q1["min"]) < 1e-6, "%s: the %s array agrees" % (case, name))
     fd = ug.GetFieldData()
@@ -91,8 +91,8 @@ for case in CASES:
                  "%s: 3D dihedral min %.2f (goal >= 10), 1st pct %.2f, max %.2f (goal <= 165)" % (case, q1["min"], q1["p1"], q1["max"]))
     # Determinism: another run in this process, and 1 thread against 2.
     _, _, again = smoothed(case)
-    digest = ft.digest(P, C, ft.array(ug, "MeanIntensity", cells=True))
-    ft.check(digest == ft.digest(ft.v2n(again.GetPoints().GetData()), cells(again), ft.array(again, "MeanIntensity", cells=True)),
+    digest = ft.digest(P, C, ft.array(ug, ft.names.MeanIntensity, cells=True))
+    ft.check(digest == ft.digest(ft.v2n(again.GetPoints().GetData()), cells(again), ft.array(again, ft.names.MeanIntensity, cells=True)),
              "%s: identical across two runs" % case)
     one = ft.run_script_with_backend(__file__, "Sequential", case)
     two = ft.run_script_with_backend(__file__, "STDThread", case)

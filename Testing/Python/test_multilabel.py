@@ -39,8 +39,8 @@ for name, folder in cases.items():
         dims = image.GetDimensions()
         ft.check(labels[(kk * dims[1] + j) * dims[0] + i] == label, "%s: the seed at %s keeps label %d" % (name, (x, y, z), label))
     field = ft.fetch(cut, 2).GetFieldData()
-    ft.check(field.GetArray("Labels").GetValue(0) == k + 1, "%s: %d labels" % (name, k + 1))
-    ft.check(field.GetAbstractArray("LabelNames").GetComponentName(1) == case.names[1], "%s: label 1 is named %s" % (name, case.names[1]))
+    ft.check(field.GetArray(ft.names.Labels).GetValue(0) == k + 1, "%s: %d labels" % (name, k + 1))
+    ft.check(field.GetAbstractArray(ft.names.LabelNames).GetComponentName(1) == case.names[1], "%s: label 1 is named %s" % (name, case.names[1]))
     if name != "abdomen-ct-totalseg":
         continue
 

@@ -90,7 +90,7 @@ after, empty = abort_after(rsp, 0.5)
 ft.check(after is not None and after < 1.0, "RSP Edge Enhancement returns %.2f s after an abort during the paths (< 1 s)" % (after or -1))
 ft.check(empty, "an aborted RSP Edge Enhancement has an empty output")
 rsp.UpdatePipeline()
-ft.check(ft.array(ft.fetch(rsp), "EdgeConfidence").max() > 0, "and runs again on the next update")
+ft.check(ft.array(ft.fetch(rsp), ft.names.EdgeConfidence).max() > 0, "and runs again on the next update")
 
 # Segmentation Surface Smoothing, aborted while the labelled mesh follows the boundary.
 ss = case.surface_smoothing(cut)

@@ -30,5 +30,5 @@ if os.path.isfile(vtu):
     r = vtkXMLUnstructuredGridReader()
     r.SetFileName(vtu)
     r.Update()
-    label = r.GetOutput().GetCellData().GetArray("Label")
+    label = r.GetOutput().GetCellData().GetArray(ft.names.Label)
     ft.check(label is not None and 0 < ft.v2n(label).sum() < label.GetNumberOfTuples(), "the written mesh holds object and background elements")

@@ -34,7 +34,7 @@ def rsp_of(case, **properties):
 if len(sys.argv) > 1:  # child run for the thread-count check
     _, _, rsp = rsp_of(sys.argv[1])
     out = ft.fetch(rsp)
-    print(ft.digest(ft.array(out, "EdgeConfidence"), ft.array(out, "EdgeMap"), ft.array(out, "ContourRegion"),
+    print(ft.digest(ft.array(out, ft.names.EdgeConfidence), ft.array(out, ft.names.EdgeMap), ft.array(out, ft.names.ContourRegion),
                     ft.v2n(ft.fetch(rsp, 2).GetPoints().GetData())))
     sys.exit(0)
 
@@ -44,13 +44,13 @@ im, out = ft.fetch(image), ft.fetch(rsp)
 shape = im.GetDimensions()[::-1]
 ft.check(out.GetDimensions() == im.GetDimensions() and out.GetSpacing() == im.GetSpacing()
          and out.GetOrigin() == im.GetOrigin(), "the EC image has the input's frame")
-ec = ft.array(out, "EdgeConfidence")
-ft.check(out.GetPointData().GetScalars().GetName() == "EdgeConfidence" and ec.dtype == np.float32,
+ec = ft.array(out, ft.names.EdgeConfidence)
+ft.check(out.GetPointData().GetScalars().GetName() == ft.names.EdgeConfidence and ec.dtype == np.float32,
          "EdgeConfidence is the active float array")
-ft.check(ft.array(out, "EdgeMap").dtype == np.uint8, "EdgeMap is uint8")
-paths = out.GetFieldData().GetArray("Paths").GetValue(0)
+ft.check(ft.array(out, ft.names.EdgeMap).dtype == np.uint8, "EdgeMap is uint8")
+paths = out.GetFieldData().GetArray(ft.names.Paths).GetValue(0)
 ft.check(paths == 50 * 100, "50 x 100 paths (%d)" % paths)
-roles = ft.array(ft.fetch(rsp, 2), "SampleRole")
+roles = ft.array(ft.fetch(rsp, 2), ft.names.SampleRole)
 ft.check((roles == 0).sum() == 50 and (roles == 1).sum() == 100, "50 sources and 100 sinks")
 contour = ft.fetch(rsp, 1)
 ids = ft.v2n(contour.GetLines().GetConnectivityArray())
@@ -64,16 +64,16 @@ for case in ("em-isbi2012-00", "nuclei-dsb2018"):
     d, image, r = rsp_of(case)
     truth = ft.v2n(ft.fetch(ft.OpenDataFile(os.path.join(d, "truth.mha"))).GetPointData().GetScalars())
     shape = ft.fetch(image).GetDimensions()[::-1]
-    ratio = ec_ratio(ft.array(ft.fetch(r), "EdgeConfidence").reshape(shape), truth.reshape(shape).astype(bool))
+    ratio = ec_ratio(ft.array(ft.fetch(r), ft.names.EdgeConfidence).reshape(shape), truth.reshape(shape).astype(bool))
     ft.check(ratio >= 3.0, "%s: EC near the boundary / far from it = %.2f >= 3" % (case, ratio))
 
 # 3. Same output across runs and for Sequential against STDThread.
 again = ft.fetch(rsp_of("nuclei-dsb2018")[2])
-ft.check(np.array_equal(ft.array(again, "EdgeConfidence"), ec), "identical EC across runs")
+ft.check(np.array_equal(ft.array(again, ft.names.EdgeConfidence), ec), "identical EC across runs")
 digests = {b: ft.run_script_with_backend(__file__, b, "nuclei-dsb2018") for b in ("Sequential", "STDThread")}
 ft.check(len(set(digests.values())) == 1, "identical output for Sequential and STDThread: %s" % digests)
 other = ft.fetch(rsp_of("nuclei-dsb2018", RandomSeed=7)[2])
-ft.check(not np.array_equal(ft.array(other, "EdgeConfidence"), ec), "another RandomSeed draws other paths")
+ft.check(not np.array_equal(ft.array(other, ft.names.EdgeConfidence), ec), "another RandomSeed draws other paths")
 
 # 4. Seed-aware Feature Nodes on the liver (bundled): fewer nodes than Canny's recipe, denser near the
 # edge map than far from it.
@@ -91,7 +91,7 @@ ijk = np.rint(ft.v2n(na.GetPoints().GetData()) / sp).astype(int)
 dn = dist[ijk[:, 2], ijk[:, 1], ijk[:, 0]]
 near, far = (dn <= 7).sum() / (dist <= 7).sum(), (dn > 20).sum() / max(1, (dist > 20).sum())
 ft.check(near > 3 * far, "node density within 7 voxels of the edges %.4f > 3 x beyond 20 %.4f" % (near, far))
-rsp_edges = ft.array(ft.fetch(r), "EdgeMap").reshape(shape).astype(bool)
+rsp_edges = ft.array(ft.fetch(r), ft.names.EdgeMap).reshape(shape).astype(bool)
 ft.check((edges | ~rsp_edges).all(), "every RSP edge voxel is an edge of the seed-aware recipe")
 
 # 5. BraTS-0006, its largest tumour slice as a 2D case; seeds drawn as the shared seeds (fixed
@@ -138,7 +138,7 @@ for draw in range(3):
     bg = band[rng.choice(len(band), 10, replace=False)]
     r = ft.RSPEdgeEnhancement(Input=source, ObjectSeeds=point_source(obj), BackgroundSeeds=point_source(bg))
     r.UpdatePipeline()
-    region = ft.array(ft.fetch(r), "ContourRegion").reshape(truth2.shape)
+    region = ft.array(ft.fetch(r), ft.names.ContourRegion).reshape(truth2.shape)
     c = ft.fetch(r, 1)
     P = np.rint(ft.v2n(c.GetPoints().GetData())[:, :2] / np.array(vol.GetSpacing()[:2])).astype(int)
     steps = np.abs(np.diff(np.vstack([P, P[:1]]), axis=0)).sum(1)

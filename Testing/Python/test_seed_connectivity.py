@@ -45,7 +45,7 @@ for name in ("SuperVoxelCut", "VoxelCut"):
             cut = ft.VoxelCut(Input=image, ObjectSeeds=so, BackgroundSeeds=sb, Scalars=["POINTS", "Intensity"], **props)
             out = ft.fetch(cut, 0)
         L = ft.array(out).reshape(H, W).astype(bool)
-        results[mode] = (L, field(out, "ObjectComponents"), field(out, "ObjectComponentVolumes"))
+        results[mode] = (L, field(out, ft.names.ObjectComponents), field(out, ft.names.ObjectComponentVolumes))
     off, fill, seeded = results[0][0], results[1][0], results[2][0]
     # Elements straddle the disks' edges: the super-voxel labels are right up to them.
     good, bad = (0.9, 0.3) if name == "SuperVoxelCut" else (0.99, 0.01)

@@ -17,7 +17,7 @@ for name, make in (("Super-Voxel Cut", lambda o, b: ft.ps.SuperVoxelCut(Mesh=mes
     ft.check(np.array_equal(points, csv) and points.sum() > 0, "%s: the CSV reader's table gives the point set's labels" % name)
 rsp = [ft.ps.RSPEdgeEnhancement(Input=case.image, ObjectSeeds=o, BackgroundSeeds=b)
        for o, b in ((case.object_seeds, case.background_seeds), (tables["object"], tables["background"]))]
-edges = [ft.array(ft.fetch(r), "EdgeConfidence") for r in rsp]
+edges = [ft.array(ft.fetch(r), ft.names.EdgeConfidence) for r in rsp]
 ft.check(np.array_equal(edges[0], edges[1]), "RSP Edge Enhancement: the same edge confidence from the CSV reader")
 bad = ft.ps.SuperVoxelCut(Mesh=mesh, ObjectSeeds=case.image, BackgroundSeeds=tables["background"], Image=case.image)
 bad.UpdatePipeline()

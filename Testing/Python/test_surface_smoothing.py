@@ -56,8 +56,8 @@ for name in CASES:
     vpc = 4 if is3d else 3
     C = cells(labelled, vpc)
     P0 = ft.v2n(labelled.GetPoints().GetData()).astype(float)
-    label = ft.array(labelled, "Label", cells=True)
-    quality = "MinDihedralAngle" if is3d else "MinAngle"
+    label = ft.array(labelled, ft.names.Label, cells=True)
+    quality = ft.names.MinDihedralAngle if is3d else ft.names.MinAngle
     floor = min(8.0 if is3d else 15.0, ft.array(labelled, quality, cells=True).min())
     image = ft.fetch(case.image)
     lo = np.array(image.GetOrigin())
@@ -69,11 +69,11 @@ for name in CASES:
         surface, mesh = ft.fetch(s, 0), ft.fetch(s, 1)
         what = "%s %s" % (name, label_text)
         field = {k: surface.GetFieldData().GetArray(k).GetValue(0) for k in
-                 ("BoundaryNodes", "PinchedNodes", "NonManifoldEdges", "ShortNodes", "MeasureChange", "ObjectMeasureBefore")}
+                 (ft.names.BoundaryNodes, ft.names.PinchedNodes, ft.names.NonManifoldEdges, ft.names.ShortNodes, ft.names.MeasureChange, ft.names.ObjectMeasureBefore)}
         P = ft.v2n(mesh.GetPoints().GetData()).astype(float)
         ft.check(mesh.GetNumberOfCells() == labelled.GetNumberOfCells() and (cells(mesh, vpc) == C).all(),
                  "%s: same elements" % what)
-        ft.check((ft.array(mesh, "Label", cells=True) == label).all(), "%s: every element keeps its label" % what)
+        ft.check((ft.array(mesh, ft.names.Label, cells=True) == label).all(), "%s: every element keeps its label" % what)
         # Output 0 lies on output 1's points.
         ft.check(np.array_equal(ft.v2n(surface.GetPoints().GetData()), ft.v2n(mesh.GetPoints().GetData())),
                  "%s: the boundary's points are the labelled mesh's" % what)
@@ -105,24 +105,24 @@ for name in CASES:
             forward = {tuple(e) for e in directed.tolist()}
             ft.check(all((b, a) in forward for a, b in directed.tolist()), "%s: closed and consistently oriented" % what)
             nonmanifold = int((counts != 2).sum())
-            ft.check(nonmanifold == field["NonManifoldEdges"], "%s: %d non-manifold edges, as reported" % (what, nonmanifold))
+            ft.check(nonmanifold == field[ft.names.NonManifoldEdges], "%s: %d non-manifold edges, as reported" % (what, nonmanifold))
             if name == "liver-ct-totalseg":  # the BraTS cuts' own boundaries pinch (objects touching at edges)
                 # The liver's touches itself at a few nodes only (parts meeting at a vertex), not along edges.
-                ft.check(nonmanifold == 0 and field["PinchedNodes"] <= 4,
-                         "%s: no edge shared by more than two faces, %d pinched nodes" % (what, field["PinchedNodes"]))
+                ft.check(nonmanifold == 0 and field[ft.names.PinchedNodes] <= 4,
+                         "%s: no edge shared by more than two faces, %d pinched nodes" % (what, field[ft.names.PinchedNodes]))
             enclosed = np.einsum("ij,ij->i", P[F[:, 0]], np.cross(P[F[:, 1]], P[F[:, 2]])).sum() / 6
             obj = X[label == 1]
             tets = np.einsum("ij,ij->i", obj[:, 1] - obj[:, 0], np.cross(obj[:, 2] - obj[:, 0], obj[:, 3] - obj[:, 0])).sum() / 6
             ft.check(abs(enclosed - tets) <= 1e-6 * tets, "%s: the surface encloses the object elements" % what)
-            ft.check(abs(field["ObjectMeasureBefore"] * (1 + field["MeasureChange"]) - tets) <= 1e-6 * tets,
+            ft.check(abs(field[ft.names.ObjectMeasureBefore] * (1 + field[ft.names.MeasureChange]) - tets) <= 1e-6 * tets,
                      "%s: MeasureChange is the object's volume change" % what)
         else:
             lines = surface.GetLines()
             ids = ft.v2n(lines.GetConnectivityArray())
             offsets = ft.v2n(lines.GetOffsetsArray())
-            ft.check(all(ids[offsets[i]] == ids[offsets[i + 1] - 1] for i in range(len(offsets) - 1)) or field["PinchedNodes"] > 0,
+            ft.check(all(ids[offsets[i]] == ids[offsets[i + 1] - 1] for i in range(len(offsets) - 1)) or field[ft.names.PinchedNodes] > 0,
                      "%s: closed polylines" % what)
-        change = field["MeasureChange"]
+        change = field[ft.names.MeasureChange]
         if method == 0:
             ft.check(change < 0, "%s: Laplacian shrinks and says so (%.2f %%)" % (what, 100 * change))
             laplacian_change[name] = change
@@ -151,7 +151,7 @@ for name in CASES:
     s.UpdatePipeline()
     ft.check(np.array_equal(ft.v2n(ft.fetch(s, 1).GetPoints().GetData()), ft.v2n(labelled.GetPoints().GetData())),
              "%s: Volume Mesh off leaves the mesh" % name)
-    ft.check(ft.fetch(s, 0).GetFieldData().GetArray("ShortNodes").GetValue(0) == 0, "%s: Volume Mesh off: no node short" % name)
+    ft.check(ft.fetch(s, 0).GetFieldData().GetArray(ft.names.ShortNodes).GetValue(0) == 0, "%s: Volume Mesh off: no node short" % name)
 
 # Bad input.
 case, cut = pipeline("nuclei-dsb2018")
@@ -171,10 +171,10 @@ ft.check(cells_of(LabelledMesh=ft.fm.ps.OutputPort(cut, 0), Relaxation=0.01, Pas
 frameless = ft.fm.ps.ProgrammableFilter(Input=ft.fm.ps.OutputPort(cut, 0), OutputDataSetType="Same as Input",
                                         Script="output.ShallowCopy(inputs[0].VTKObject)\noutput.GetFieldData().Initialize()")
 ft.check(cells_of(LabelledMesh=frameless) == 0, "a mesh without its image frame: error")
-scaled = ft.fm.ps.Calculator(Input=ft.fm.ps.OutputPort(cut, 0), AttributeType="Cell Data", ResultArrayName="Label",
+scaled = ft.fm.ps.Calculator(Input=ft.fm.ps.OutputPort(cut, 0), AttributeType="Cell Data", ResultArrayName=ft.names.Label,
                              Function="Label*2.5", ResultArrayType="Double")
 ft.check(cells_of(LabelledMesh=scaled) == 0, "fractional labels: error")
-negative = ft.fm.ps.Calculator(Input=ft.fm.ps.OutputPort(cut, 0), AttributeType="Cell Data", ResultArrayName="Label",
+negative = ft.fm.ps.Calculator(Input=ft.fm.ps.OutputPort(cut, 0), AttributeType="Cell Data", ResultArrayName=ft.names.Label,
                                Function="Label-1", ResultArrayType="Double")
 ft.check(cells_of(LabelledMesh=negative) == 0, "negative labels: error")
 print("all surface smoothing checks passed")
