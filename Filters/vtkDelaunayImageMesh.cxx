@@ -21,7 +21,6 @@
 #include "vtkUnstructuredGrid.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 vtkStandardNewMacro(vtkDelaunayImageMesh);

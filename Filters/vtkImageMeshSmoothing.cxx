@@ -14,7 +14,6 @@
 #include "vtkUnstructuredGrid.h"
 
 #include <algorithm>
-#include <chrono>
 
 namespace
 {

@@ -20,7 +20,6 @@
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
-#include <chrono>
 
 namespace
 {

@@ -26,7 +26,6 @@
 #include "vtkUnstructuredGrid.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 vtkStandardNewMacro(vtkSuperVoxelCut);

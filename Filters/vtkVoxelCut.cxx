@@ -18,7 +18,6 @@
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 vtkStandardNewMacro(vtkVoxelCut);

@@ -39,6 +39,21 @@ inline std::vector<float> Disk(const ImageGeometry& g, double cx, double cy, dou
 
 // The CGAL Delaunay mesh of distinct `pts` (index space; triangles for a 2D grid), positively
 // oriented, into `mesh`; false (with a failure) when meshing fails.
+// Nodes on every second voxel centre of a 2D grid, plus its last column and last row: a lattice
+// mesh's nodes (the last corner appears twice).
+inline std::vector<std::array<double, 3>> LatticeNodes(const ImageGeometry& g)
+{
+  std::vector<std::array<double, 3>> pts;
+  for (int j = 0; j < g.Dims[1]; j += 2)
+    for (int i = 0; i < g.Dims[0]; i += 2)
+      pts.push_back({ { double(i), double(j), 0.0 } });
+  for (int j = 0; j < g.Dims[1]; ++j)
+    pts.push_back({ { double(g.Dims[0] - 1), double(j), 0.0 } });
+  for (int i = 0; i < g.Dims[0]; ++i)
+    pts.push_back({ { double(i), double(g.Dims[1] - 1), 0.0 } });
+  return pts;
+}
+
 inline bool CGALMeshOfNodes(const ImageGeometry& g, std::vector<std::array<double, 3>> pts, SimplexMesh& mesh)
 {
   std::sort(pts.begin(), pts.end());

@@ -6,6 +6,7 @@
 #include "SimplexMesh.h"
 #include "SeedGeodesics.h"
 #include "SegmentationSurfaceSmoothing.h"
+#include "TestHelpers.h"
 
 #include <gtest/gtest.h>
 
@@ -60,14 +61,7 @@ struct Lattice
   std::vector<double> Mean, Count;
   bool Make(const ImageGeometry& g, const std::vector<float>& image, int channels)
   {
-    std::vector<std::array<double, 3>> pts;
-    for (int j = 0; j < g.Dims[1]; j += 2)
-      for (int i = 0; i < g.Dims[0]; i += 2)
-        pts.push_back({ { double(i), double(j), 0.0 } });
-    for (int j = 0; j < g.Dims[1]; ++j)
-      pts.push_back({ { double(g.Dims[0] - 1), double(j), 0.0 } });
-    for (int i = 0; i < g.Dims[0]; ++i)
-      pts.push_back({ { double(i), double(g.Dims[1] - 1), 0.0 } });
+    std::vector<std::array<double, 3>> pts = featuremesh_test::LatticeNodes(g);
     std::sort(pts.begin(), pts.end());
     pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
     const DelaunayResult d = Triangulate2D(pts);

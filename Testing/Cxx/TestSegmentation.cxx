@@ -661,14 +661,7 @@ struct LatticeMesh
   SuperVoxelCutData Data;
   bool Make(const ImageGeometry& g, const std::vector<float>& image)
   {
-    std::vector<std::array<double, 3>> pts;
-    for (int j = 0; j < g.Dims[1]; j += 2)
-      for (int i = 0; i < g.Dims[0]; i += 2)
-        pts.push_back({ { double(i), double(j), 0.0 } });
-    for (int j = 0; j < g.Dims[1]; ++j)
-      pts.push_back({ { double(g.Dims[0] - 1), double(j), 0.0 } });
-    for (int i = 0; i < g.Dims[0]; ++i)
-      pts.push_back({ { double(i), double(g.Dims[1] - 1), 0.0 } });
+    std::vector<std::array<double, 3>> pts = LatticeNodes(g);
     if (!CGALMeshOfNodes(g, pts, this->Mesh))
       return false;
     this->Stats = ComputeElementStatistics(ElementRasterizer(this->Mesh), image.data(), SerialFor());

@@ -31,8 +31,8 @@ for folder in ("scripts/featuremesh", "scripts", "Testing/Python", "Testing/MPI"
 ft.check(not found, "no GetArray(\"...\") literal of a contract name in the package, the scripts or the tests %s" % found)
 # One way to the package: the scripts find it beside them, the tests through ctest's PYTHONPATH.
 hacks, needle = [], "sys.path." + "insert"  # not written whole: this file would match
-for folder, _, files in os.walk(root):
-    if os.path.relpath(folder, root).split(os.sep)[0] in ("scripts", "Testing"):
+for top in ("scripts", "Testing"):
+    for folder, _, files in os.walk(os.path.join(root, top)):
         for name in files:
             if name.endswith(".py"):
                 with open(os.path.join(folder, name)) as f:
