@@ -191,5 +191,6 @@ void vtkImageMeshSmoothing::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MinAngle: " << this->MinAngle << "\n";
   os << indent << "MinDihedralAngle: " << this->MinDihedralAngle << "\n";
   os << indent << "SliverRemoval: " << this->SliverRemoval << "\n";
+  os << indent << "MaxDihedralAngle: " << this->MaxDihedralAngle << "\n";
   os << indent << "SliverAngle: " << this->SliverAngle << "\n";
 }

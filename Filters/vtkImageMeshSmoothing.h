@@ -62,7 +62,8 @@ public:
   vtkGetMacro(Flips, bool);
   vtkBooleanMacro(Flips, bool);
   /// Add nodes (Delaunay refinement) where elements stay below MinAngle (2D, default 20 degrees)
-  /// or MinDihedralAngle (3D, default 10 degrees) after the sweeps. On by default.
+  /// or MinDihedralAngle (3D, default 10.5 degrees) after the sweeps; in 3D TetGen's optimisation
+  /// then flips tetrahedra with a dihedral angle above MaxDihedralAngle (default 150). On by default.
   vtkSetMacro(QualityRefinement, bool);
   vtkGetMacro(QualityRefinement, bool);
   vtkBooleanMacro(QualityRefinement, bool);
@@ -70,6 +71,8 @@ public:
   vtkGetMacro(MinAngle, double);
   vtkSetMacro(MinDihedralAngle, double);
   vtkGetMacro(MinDihedralAngle, double);
+  vtkSetMacro(MaxDihedralAngle, double);
+  vtkGetMacro(MaxDihedralAngle, double);
   /// 3D: perturb the free vertices of tetrahedra whose minimum dihedral angle is below SliverAngle.
   vtkSetMacro(SliverRemoval, bool);
   vtkGetMacro(SliverRemoval, bool);

@@ -1289,6 +1289,12 @@ TEST(ImageMeshSmoothing, SlackBeyondTwoVoxels)
   Smoothing(MeshOf(image), image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "slack", out); },
     [](vtkImageMeshSmoothing* s) { s->SetFixedNodeSlack(Inf); });
 }
+TEST(ImageMeshSmoothing, OptimisationAngleOutOfRange)
+{
+  auto image = Disc();
+  Smoothing(MeshOf(image), image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "maximum dihedral", out); },
+    [](vtkImageMeshSmoothing* s) { s->SetMaxDihedralAngle(NaN); });
+}
 TEST(ImageMeshSmoothing, MeshWithoutFixedArrayMovesEveryNodeButTheCorners)
 {
   auto image = Disc();

@@ -92,7 +92,7 @@ int main(int argc, char* argv[])
     GETTER(vtkImageMeshSmoothing, FixedNodeSlack), GETTER(vtkImageMeshSmoothing, Flips),
     GETTER(vtkImageMeshSmoothing, QualityRefinement), GETTER(vtkImageMeshSmoothing, MinAngle),
     GETTER(vtkImageMeshSmoothing, MinDihedralAngle), GETTER(vtkImageMeshSmoothing, SliverRemoval),
-    GETTER(vtkImageMeshSmoothing, SliverAngle),
+    GETTER(vtkImageMeshSmoothing, MaxDihedralAngle), GETTER(vtkImageMeshSmoothing, SliverAngle),
     GETTER(vtkSuperVoxelCut, Lambda), GETTER(vtkSuperVoxelCut, Sigma), GETTER(vtkSuperVoxelCut, Bins),
     GETTER(vtkSuperVoxelCut, ScaleByContact), GETTER(vtkSuperVoxelCut, VoxelRegionTerm),
     GETTER(vtkSuperVoxelCut, Connectivity), GETTER(vtkSuperVoxelCut, Bandwidth),

@@ -240,6 +240,9 @@ TEST(ImageMeshSmoothing, BadParametersAreNamed)
   p = ImageMeshSmoothingParameters();
   p.FixedNodeSlack = -1;
   EXPECT_NE(ValidateParameters(p).find("slack"), std::string::npos);
+  p = ImageMeshSmoothingParameters();
+  p.MaxDihedralAngle = 100;
+  EXPECT_NE(ValidateParameters(p).find("maximum dihedral"), std::string::npos);
 }
 
 namespace

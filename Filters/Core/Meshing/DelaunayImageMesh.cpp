@@ -211,7 +211,8 @@ DelaunayResult TetrahedralizeTetGen(const std::vector<std::array<double, 3>>& po
       in.facetmarkerlist[f] = f + 1;
     }
     char buffer[64];
-    std::snprintf(buffer, sizeof(buffer), "pq%g/%g%s", o.RadiusEdgeRatio, o.MinDihedralAngle, o.PreserveBoundary ? "Y" : "");
+    std::snprintf(buffer, sizeof(buffer), "pq%g/%g%so/%g", o.RadiusEdgeRatio, o.MinDihedralAngle, o.PreserveBoundary ? "Y" : "",
+      o.MaxDihedralAngle);
     switches += buffer;
   }
   std::vector<char> sw(switches.begin(), switches.end());
@@ -235,6 +236,15 @@ DelaunayResult TetrahedralizeTetGen(const std::vector<std::array<double, 3>>& po
   {
     r.Error = "TetGen produced no tetrahedra; the nodes are probably coplanar.";
     return r;
+  }
+  // Every node keeps its place: TetGen's optimisation smooths only the nodes it added.
+  for (size_t i = 0; i < points.size(); ++i)
+  {
+    if (!std::equal(points[i].begin(), points[i].end(), out.pointlist + 3 * i))
+    {
+      r.Error = "TetGen moved node " + std::to_string(i) + "; please report this input.";
+      return r;
+    }
   }
   r.VerticesPerCell = 4;
   r.Points = points;

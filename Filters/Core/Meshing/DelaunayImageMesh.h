@@ -24,6 +24,9 @@ struct DelaunayImageMeshParameters
   bool QualityRefinement = false;
   double RadiusEdgeRatio = 2.0;
   double MinDihedralAngle = 10.0;
+  // TetGen's mesh optimisation after refinement (edge and face flips, smoothing of the nodes it
+  // added) works on tetrahedra with a larger dihedral angle (deg); 165 is TetGen's own default.
+  double MaxDihedralAngle = 165.0;
   // Refinement adds no node on the box faces (TetGen -Y): fewer nodes, where nodes near a face
   // would otherwise split it finely.
   bool PreserveBoundary = false;

@@ -621,6 +621,10 @@ std::string ValidateParameters(const ImageMeshSmoothingParameters& p)
   {
     return "the refinement's minimum dihedral angle must be in [0, 30) degrees.";
   }
+  if (!(p.MaxDihedralAngle >= 120.0 && p.MaxDihedralAngle <= 179.0))
+  {
+    return "the optimisation's maximum dihedral angle must be in [120, 179] degrees.";
+  }
   if (!(p.SliverAngle >= 0.0 && p.SliverAngle <= 30.0))
   {
     return "the sliver angle must be in [0, 30] degrees.";
@@ -945,6 +949,7 @@ bool RefineQuality(Smoother& s, const std::vector<std::uint8_t>& fixed, const Im
   o.QualityRefinement = true;
   o.MinDihedralAngle = p.MinDihedralAngle;
   o.RadiusEdgeRatio = p.RadiusEdgeRatio;
+  o.MaxDihedralAngle = p.MaxDihedralAngle;
   o.PreserveBoundary = true;
   const double minAngle = p.MinAngle;
   const bool planar = vpc == 3;
