@@ -73,7 +73,8 @@ public:
   vtkGetMacro(MinDihedralAngle, double);
   vtkSetMacro(MaxDihedralAngle, double);
   vtkGetMacro(MaxDihedralAngle, double);
-  /// 3D: perturb the free vertices of tetrahedra whose minimum dihedral angle is below SliverAngle.
+  /// 3D: tetrahedra whose minimum dihedral angle is below SliverAngle: flips where no vertex may
+  /// move, else perturbation of their free vertices.
   vtkSetMacro(SliverRemoval, bool);
   vtkGetMacro(SliverRemoval, bool);
   vtkBooleanMacro(SliverRemoval, bool);

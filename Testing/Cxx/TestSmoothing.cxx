@@ -1,6 +1,7 @@
 // Unit tests of the Smoothing library (stage 3's image mesh smoothing, stage 6's surface smoothing).
 #include "ImageMeshSmoothing.h"
 #include "SegmentationSurfaceSmoothing.h"
+#include "SliverFlips.h"
 #include "ElementRasterizer.h"
 #include "DelaunayImageMesh.h"
 #include "TestHelpers.h"
@@ -223,6 +224,138 @@ TEST(ImageMeshSmoothing, RefinementReachesTheAngleBounds)
     else
       EXPECT_GT(MinimumAngle(r.Mesh), MinimumAngle(mesh));
   }
+}
+
+namespace
+{
+// Signed volume of tetrahedron c of `cells`, index space.
+double TetVolume(const std::vector<std::array<double, 3>>& p, const std::vector<std::int64_t>& cells, size_t c)
+{
+  const auto& a = p[cells[4 * c]];
+  auto d = [&](int k, int x) { return p[cells[4 * c + k]][x] - a[x]; };
+  return (d(1, 0) * (d(2, 1) * d(3, 2) - d(2, 2) * d(3, 1)) - d(1, 1) * (d(2, 0) * d(3, 2) - d(2, 2) * d(3, 0)) +
+           d(1, 2) * (d(2, 0) * d(3, 1) - d(2, 1) * d(3, 0))) /
+    6.0;
+}
+
+// The faces with one tetrahedron (the boundary), as sorted vertex triples.
+std::set<std::array<std::int64_t, 3>> BoundaryFaces(const std::vector<std::int64_t>& cells)
+{
+  std::map<std::array<std::int64_t, 3>, int> count;
+  for (size_t c = 0; c < cells.size() / 4; ++c)
+  {
+    for (int k = 0; k < 4; ++k)
+    {
+      std::array<std::int64_t, 3> f = { { cells[4 * c + (k + 1) % 4], cells[4 * c + (k + 2) % 4], cells[4 * c + (k + 3) % 4] } };
+      std::sort(f.begin(), f.end());
+      ++count[f];
+    }
+  }
+  std::set<std::array<std::int64_t, 3>> out;
+  for (const auto& [f, n] : count)
+  {
+    EXPECT_LE(n, 2);
+    if (n == 1)
+      out.insert(f);
+  }
+  return out;
+}
+
+double MinimumDihedral(const ImageGeometry& g, const std::vector<std::array<double, 3>>& p, const std::vector<std::int64_t>& cells)
+{
+  return MinimumAngle(SimplexMesh(g, p, cells, 4));
+}
+} // namespace
+
+TEST(SliverFlips, TwoThreeFlipReplacesAFlatTetrahedron)
+{
+  // A flat tetrahedron on the triangle 0-1-2 (apex 3 just above it) and a tall one below (apex 4):
+  // the edge 3-4 crosses the triangle, and the three tetrahedra around it are better.
+  ImageGeometry g;
+  g.Dims = { { 4, 4, 4 } };
+  const std::vector<std::array<double, 3>> p = { { { 0, 0, 1 } }, { { 3, 0, 1 } }, { { 0, 3, 1 } }, { { 1, 1, 1.2 } },
+    { { 1, 1, -1 } } };
+  std::vector<std::int64_t> cells = { 0, 1, 2, 3, 1, 0, 2, 4 };
+  ASSERT_GT(TetVolume(p, cells, 0), 0.0);
+  ASSERT_GT(TetVolume(p, cells, 1), 0.0);
+  const double before = MinimumDihedral(g, p, cells), volume = TetVolume(p, cells, 0) + TetVolume(p, cells, 1);
+  const auto boundary = BoundaryFaces(cells);
+  // A sliver with a vertex that may move is left to perturbation.
+  const std::vector<std::uint8_t> apexMoves = { 0, 0, 0, 1, 0 }, noneMove(5, 0);
+  EXPECT_EQ(FlipSlivers(g, p, cells, 20.0, 4, &apexMoves), 0);
+  EXPECT_EQ(FlipSlivers(g, p, cells, 20.0, 4, &noneMove), 1);
+  ASSERT_EQ(cells.size(), 12u);
+  double after = 0.0;
+  for (size_t c = 0; c < 3; ++c)
+  {
+    EXPECT_GT(TetVolume(p, cells, c), 0.0) << c;
+    after += TetVolume(p, cells, c);
+  }
+  EXPECT_NEAR(after, volume, 1e-12);
+  EXPECT_EQ(BoundaryFaces(cells), boundary);
+  EXPECT_GT(MinimumDihedral(g, p, cells), before);
+  // Nothing to improve any more: a second call leaves the cells alone.
+  const auto flipped = cells;
+  FlipSlivers(g, p, cells, 20.0);
+  EXPECT_EQ(cells, flipped);
+}
+
+TEST(SliverFlips, ThreeTwoFlipRemovesAnEdge)
+{
+  // Three tetrahedra around the edge 3-4, which crosses the triangle 0-1-2 near its side 0-1: the
+  // tetrahedron on that side is flat, the two on the triangle are not.
+  ImageGeometry g;
+  g.Dims = { { 6, 6, 6 } };
+  const std::vector<std::array<double, 3>> p = { { { 0, 0, 2.5 } }, { { 3, 0, 2.5 } }, { { 1.5, 2.6, 2.5 } },
+    { { 1.5, 0.1, 4.5 } }, { { 1.5, 0.1, 0.5 } } };
+  std::vector<std::int64_t> cells;
+  for (int i = 0; i < 3; ++i)
+  {
+    cells.insert(cells.end(), { i, (i + 1) % 3, 3, 4 });
+    if (TetVolume(p, cells, i) < 0)
+      std::swap(cells[4 * i], cells[4 * i + 1]);
+  }
+  const double before = MinimumDihedral(g, p, cells);
+  const auto boundary = BoundaryFaces(cells);
+  EXPECT_EQ(FlipSlivers(g, p, cells, 20.0), 1);
+  ASSERT_EQ(cells.size(), 8u);
+  EXPECT_GT(TetVolume(p, cells, 0), 0.0);
+  EXPECT_GT(TetVolume(p, cells, 1), 0.0);
+  EXPECT_EQ(BoundaryFaces(cells), boundary);
+  EXPECT_GT(MinimumDihedral(g, p, cells), before);
+}
+
+TEST(SliverFlips, AJitteredMeshStaysATilingOfTheBoxAndImproves)
+{
+  ImageGeometry g;
+  g.Dims = { { 18, 16, 14 } };
+  g.Spacing = { { 1.0, 1.5, 0.8 } };
+  std::vector<std::uint8_t> fixed;
+  const SimplexMesh mesh = JitteredMesh(g, fixed, 5);
+  std::vector<std::int64_t> cells = mesh.Cells();
+  const auto& p = mesh.Points();
+  const auto boundary = BoundaryFaces(cells);
+  const double before = MinimumAngle(mesh);
+  const std::int64_t flips = FlipSlivers(g, p, cells, 20.0);
+  EXPECT_GT(flips, 0);
+  double volume = 0.0;
+  for (size_t c = 0; c < cells.size() / 4; ++c)
+  {
+    ASSERT_GT(TetVolume(p, cells, c), 0.0) << c;
+    volume += TetVolume(p, cells, c);
+  }
+  EXPECT_NEAR(volume, 17.0 * 15.0 * 13.0, 1e-9);
+  EXPECT_EQ(BoundaryFaces(cells), boundary);
+  EXPECT_GE(MinimumDihedral(g, p, cells), before);
+  // Every voxel centre still has exactly one owner.
+  const SimplexMesh flipped(g, p, cells, 4);
+  ElementRasterizer raster(flipped);
+  std::vector<int> owners(g.Size(), 0);
+  for (std::int64_t e = 0; e < flipped.NumberOfElements(); ++e)
+  {
+    raster.ForEachVoxel(e, [&](std::int64_t v) { ++owners[v]; });
+  }
+  EXPECT_TRUE(std::all_of(owners.begin(), owners.end(), [](int n) { return n == 1; }));
 }
 
 TEST(ImageMeshSmoothing, BadParametersAreNamed)

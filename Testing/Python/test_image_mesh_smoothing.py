@@ -63,6 +63,9 @@ for case in CASES:
     ft.check(landed.all() and (np.abs(I[snapped] - I0[snapped]) <= 1.5 + 1e-9).all(),
              "%s: the %d Fixed nodes that moved moved onto the box, by at most 1.5 voxels" % (case, snapped.sum()))
     if k == 3:
+        fd = ug.GetFieldData()
+        ft.check(fd.GetArray(ft.names.SliverFlips).GetValue(0) > 0 and fd.GetArray(ft.names.RefinementRuns).GetValue(0) == 1,
+                 "%s: %d sliver flips, one refinement run" % (case, fd.GetArray(ft.names.SliverFlips).GetValue(0)))
         ft.check(ug.GetFieldData().GetArray(ft.names.SnappedNodes).GetValue(0) >= snapped.sum() > 0,
                  "%s: SnappedNodes counts them (%d)" % (case, ug.GetFieldData().GetArray(ft.names.SnappedNodes).GetValue(0)))
     on_face = (np.abs(I0) < 1e-9) | (np.abs(I0 - (dims - 1)) < 1e-9)

@@ -12,6 +12,39 @@ using namespace vector3;
 constexpr double Degrees = 180.0 / 3.14159265358979323846;
 } // namespace
 
+double SimplexAngleScore(const V3* const* v, int vpc)
+{
+  double largest = -1.0;
+  if (vpc == 3)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      const V3 u = Sub(*v[(k + 1) % 3], *v[k]), w = Sub(*v[(k + 2) % 3], *v[k]);
+      largest = std::max(largest, (u[0] * w[0] + u[1] * w[1]) / std::sqrt((u[0] * u[0] + u[1] * u[1]) * (w[0] * w[0] + w[1] * w[1])));
+    }
+    return -largest;
+  }
+  V3 n[4];
+  double length[4];
+  for (int f = 0; f < 4; ++f)
+  {
+    n[f] = Cross(Sub(*v[(f + 2) % 4], *v[(f + 1) % 4]), Sub(*v[(f + 3) % 4], *v[(f + 1) % 4]));
+    length[f] = std::sqrt(Dot(n[f], n[f]));
+    if (Dot(n[f], Sub(*v[f], *v[(f + 1) % 4])) > 0)
+    {
+      length[f] = -length[f];
+    }
+  }
+  for (int k = 0; k < 4; ++k)
+  {
+    for (int l = k + 1; l < 4; ++l)
+    {
+      largest = std::max(largest, -Dot(n[k], n[l]) / (length[k] * length[l]));
+    }
+  }
+  return -largest;
+}
+
 double SimplexMinAngle(const V3* const* v, int vpc)
 {
   double smallest = 180.0;

@@ -19,4 +19,8 @@ void ElementQuality(const SimplexMesh& mesh, std::vector<double>& minAngle, std:
 // Minimum angle (triangle) or minimum dihedral angle (tetrahedron) in degrees of the element with
 // vertices v[0..vpc) (any orientation; 0 for a flat one).
 double SimplexMinAngle(const std::array<double, 3>* const* v, int verticesPerCell);
+
+// A cheap stand-in for SimplexMinAngle, monotone in it (no inverse cosine): minus the largest cosine
+// of the element's angles (triangle) or dihedral angles (tetrahedron); -cos(angle) at the angle.
+double SimplexAngleScore(const std::array<double, 3>* const* v, int verticesPerCell);
 } // namespace featuremesh

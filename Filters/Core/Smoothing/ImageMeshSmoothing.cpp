@@ -2,9 +2,11 @@
 #include "Memory.h"
 
 #include "DelaunayImageMesh.h"
+#include "ElementQuality.h"
 #include "ElementRasterizer.h"
 #include "ExactPredicates.h"
 #include "ImageFilters.h"
+#include "SliverFlips.h"
 #include "Vector3.h"
 
 #include <algorithm>
@@ -63,41 +65,6 @@ double Measure(const V3* const* v, int vpc)
   return std::fabs(SimplexMeasure(v, vpc));
 }
 
-// A cheap stand-in for the smallest (dihedral) angle, monotone in it: minus the largest cosine of
-// the element's angles (triangle) or dihedral angles (tetrahedron). Frame coordinates.
-double AngleScore(const V3* const* v, int vpc)
-{
-  double largest = -1.0;
-  if (vpc == 3)
-  {
-    for (int k = 0; k < 3; ++k)
-    {
-      const V3 u = Sub(*v[(k + 1) % 3], *v[k]), w = Sub(*v[(k + 2) % 3], *v[k]);
-      largest = std::max(largest, (u[0] * w[0] + u[1] * w[1]) / std::sqrt((u[0] * u[0] + u[1] * u[1]) * (w[0] * w[0] + w[1] * w[1])));
-    }
-    return -largest;
-  }
-  V3 n[4];
-  double length[4];
-  for (int f = 0; f < 4; ++f)
-  {
-    n[f] = Cross(Sub(*v[(f + 2) % 4], *v[(f + 1) % 4]), Sub(*v[(f + 3) % 4], *v[(f + 1) % 4]));
-    length[f] = std::sqrt(Dot(n[f], n[f]));
-    if (Dot(n[f], Sub(*v[f], *v[(f + 1) % 4])) > 0)
-    {
-      length[f] = -length[f];
-    }
-  }
-  for (int k = 0; k < 4; ++k)
-  {
-    for (int l = k + 1; l < 4; ++l)
-    {
-      largest = std::max(largest, -Dot(n[k], n[l]) / (length[k] * length[l]));
-    }
-  }
-  return -largest;
-}
-
 int ExactOrientation(const V3* const* v, int vpc)
 {
   return vpc == 3 ? Orientation2(*v[0], *v[1], *v[2]) : Orientation3(*v[0], *v[1], *v[2], *v[3]);
@@ -145,7 +112,7 @@ public:
         frame[k] = g.IndexToFrame(*v[k]);
         f[k] = &frame[k];
       }
-      q = std::min(q, AngleScore(f, this->Vpc));
+      q = std::min(q, SimplexAngleScore(f, this->Vpc));
       if (q < floor)
       {
         return q;
@@ -468,7 +435,7 @@ bool PerturbVertex(Smoother& s, std::int64_t vertex, double threshold)
         shortest = std::min(shortest, std::sqrt(Dot(d, d)));
       }
     }
-    if (AngleScore(v, 4) >= threshold)
+    if (SimplexAngleScore(v, 4) >= threshold)
     {
       continue;
     }
@@ -538,7 +505,7 @@ std::int64_t PerturbSlivers(Smoother& s, double sliverAngle, int passes, const P
     V3 frame[4];
     const V3* v[4];
     ElementFrame(s, e, frame, v);
-    return AngleScore(v, 4) < threshold;
+    return SimplexAngleScore(v, 4) < threshold;
   };
   std::vector<std::uint8_t> sliver(m);
   parallel(m, 4096, [&](std::int64_t b, std::int64_t e) {
@@ -935,7 +902,7 @@ bool RestoreDelaunay(Smoother& s, const std::vector<std::uint8_t>& moved, std::v
 // Step 4: quality refinement to the angle bounds (CGAL's 2D mesher, TetGen in 3D after snapping
 // nodes near the box onto it); the added nodes are free. False with result.Error or when aborted.
 bool RefineQuality(Smoother& s, const std::vector<std::uint8_t>& fixed, const ImageMeshSmoothingParameters& p,
-  const ProgressFunction& progress, ImageMeshSmoothingResult& result)
+  double maxDihedralAngle, const ProgressFunction& progress, ImageMeshSmoothingResult& result)
 {
   const ImageGeometry& g = s.Topology.Geometry();
   const int vpc = s.Topology.VerticesPerCell();
@@ -949,7 +916,7 @@ bool RefineQuality(Smoother& s, const std::vector<std::uint8_t>& fixed, const Im
   o.QualityRefinement = true;
   o.MinDihedralAngle = p.MinDihedralAngle;
   o.RadiusEdgeRatio = p.RadiusEdgeRatio;
-  o.MaxDihedralAngle = p.MaxDihedralAngle;
+  o.MaxDihedralAngle = maxDihedralAngle;
   o.PreserveBoundary = true;
   const double minAngle = p.MinAngle;
   const bool planar = vpc == 3;
@@ -967,6 +934,7 @@ bool RefineQuality(Smoother& s, const std::vector<std::uint8_t>& fixed, const Im
     result.Error = "quality refinement failed: " + d.Error;
     return false;
   }
+  ++result.RefinementRuns;
   result.AddedNodes = static_cast<std::int64_t>(d.Points.size() - frame.size());
   std::vector<V3> index = s.Points;
   for (size_t i = frame.size(); i < d.Points.size(); ++i)
@@ -979,6 +947,45 @@ bool RefineQuality(Smoother& s, const std::vector<std::uint8_t>& fixed, const Im
   fixedAll.resize(refined.NumberOfPoints(), 0);
   Smoother r(refined, FreeAxes(refined, fixedAll));
   s = std::move(r);
+  return true;
+}
+// Step 5: 2-3 / 3-2 flips around the slivers no vertex of which may move (Canny nodes: only the
+// connectivity can change there), then perturbation of the others' free vertices. False when
+// progress asked to abort.
+bool RemoveSlivers(Smoother& s, double sliverAngle, const ParallelFor& parallel, const ProgressFunction& progress,
+  ImageMeshSmoothingResult& result)
+{
+  std::vector<std::int64_t> cells = s.Topology.Cells();
+  const std::int64_t flips = FlipSlivers(s.Topology.Geometry(), s.Points, cells, sliverAngle, 4, &s.Free);
+  result.SliverFlips += flips;
+  if (flips > 0)
+  {
+    Smoother flipped(SimplexMesh(s.Topology.Geometry(), s.Points, std::move(cells), 4), s.Free);
+    s = std::move(flipped);
+  }
+  result.Perturbed += PerturbSlivers(s, sliverAngle, 10, parallel, progress, result.Aborted);
+  if (result.Aborted)
+  {
+    return false;
+  }
+  s.Topology.SetPoints(s.Points);
+  return true;
+}
+
+// True when every element's smallest dihedral angle is at least `degrees`.
+bool ReachesAngle(const Smoother& s, double degrees)
+{
+  const double threshold = -std::cos(degrees * 3.14159265358979323846 / 180.0);
+  for (std::int64_t e = 0; e < s.Topology.NumberOfElements(); ++e)
+  {
+    V3 frame[4];
+    const V3* v[4];
+    ElementFrame(s, e, frame, v);
+    if (SimplexAngleScore(v, 4) < threshold)
+    {
+      return false;
+    }
+  }
   return true;
 }
 } // namespace
@@ -1043,25 +1050,33 @@ ImageMeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vec
   }
   std::vector<float>().swap(images.Gradient);
   result.SweepSeconds = since(t0);
-  // 4. Quality refinement.
-  t0 = Clock::now();
-  if (refine && !RefineQuality(s, fixed, p, SubProgress(progress, sweepShare, refineEnd), result))
+  // TetGen's optimisation flips by the largest dihedral angle and can undercut the bound on the
+  // smallest: when the finished mesh misses it by more than half a degree, steps 4-5 run again on
+  // the swept nodes with TetGen's own optimisation target.
+  const double tetgenOwn = DelaunayImageMeshParameters().MaxDihedralAngle;
+  const std::vector<V3> swept = vpc == 4 && refine && p.MaxDihedralAngle < tetgenOwn ? s.Points : std::vector<V3>();
+  for (double maxDihedral = p.MaxDihedralAngle;; maxDihedral = tetgenOwn)
   {
-    return result;
-  }
-  result.RefinementSeconds = since(t0);
-  // 5. Sliver perturbation.
-  t0 = Clock::now();
-  if (perturb)
-  {
-    result.Perturbed = PerturbSlivers(s, p.SliverAngle, 10, parallel, SubProgress(progress, refine ? refineEnd : sweepShare, 1.0), result.Aborted);
-    if (result.Aborted)
+    // 4. Quality refinement.
+    t0 = Clock::now();
+    if (refine && !RefineQuality(s, fixed, p, maxDihedral, SubProgress(progress, sweepShare, refineEnd), result))
     {
       return result;
     }
-    s.Topology.SetPoints(s.Points);
+    result.RefinementSeconds += since(t0);
+    // 5. Sliver removal: flips where no vertex may move, then perturbation.
+    t0 = Clock::now();
+    if (perturb && !RemoveSlivers(s, p.SliverAngle, parallel, SubProgress(progress, refine ? refineEnd : sweepShare, 1.0), result))
+    {
+      return result;
+    }
+    result.SliverSeconds += since(t0);
+    if (swept.empty() || maxDihedral == tetgenOwn || ReachesAngle(s, p.MinDihedralAngle - 0.5))
+    {
+      break;
+    }
+    s.Points = swept;
   }
-  result.SliverSeconds = since(t0);
   result.Mesh = std::move(s.Topology);
   return result;
 }

@@ -3,7 +3,7 @@
 // element, colours in order, a colour's nodes in parallel; the result does not depend on the thread
 // count) to its CVT or ODT position under a feature density, then restores the Delaunay property;
 // Delaunay refinement then adds nodes where the angle bounds are still missed, and tetrahedral
-// meshes finish with sliver perturbation.
+// meshes finish with sliver flips and perturbation.
 //
 // Density (thesis 2.3): rho(T) = 1 + FeatureWeight * g(T) / mean(g), g(T) the gradient magnitude of
 // the Gaussian-smoothed image averaged over T's centroid and the centroids of the sub-simplices
@@ -61,8 +61,9 @@ struct ImageMeshSmoothingParameters
   // this (deg). 150 instead of TetGen's 165 takes the 1st percentile of the smallest dihedral
   // angle from 16 to 20 degrees on the shared 3D cases (docs/smoothing.md).
   double MaxDihedralAngle = 150.0;
-  // 3D: after the last sweep, move the free vertices of tetrahedra whose minimum dihedral angle is
-  // below SliverAngle (degrees) to raise it (sliver perturbation; topology fixed).
+  // 3D: after the last sweep, tetrahedra whose minimum dihedral angle is below SliverAngle
+  // (degrees): 2-3 and 3-2 flips that raise it where no vertex may move (SliverFlips.h), else
+  // perturbation of their free vertices.
   bool SliverRemoval = true;
   double SliverAngle = 20.0;
 };
@@ -87,9 +88,11 @@ struct ImageMeshSmoothingResult
   int IterationsRun = 0;
   std::int64_t Moves = 0;      // accepted moves over all sweeps
   std::int64_t Flips = 0;      // 2D edge flips (3D: tetrahedra changed by re-tetrahedralising)
+  std::int64_t SliverFlips = 0; // 3D sliver-removal 2-3 and 3-2 flips
   std::int64_t Perturbed = 0;  // 3D sliver-removal moves
   std::int64_t AddedNodes = 0; // by quality refinement; they follow the input's points
   std::int64_t SnappedNodes = 0; // 3D: moved onto the image box before refinement
+  int RefinementRuns = 0;        // 1, or 2 when TetGen's optimisation undercut the bound (then at 165 deg)
   // Seconds: sweeps (with the density image and the flips / re-tetrahedralisation), refinement, slivers.
   double SweepSeconds = 0, RefinementSeconds = 0, SliverSeconds = 0;
   bool Aborted = false;
