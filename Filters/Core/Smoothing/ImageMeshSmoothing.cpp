@@ -949,6 +949,7 @@ bool RefineQuality(Smoother& s, const std::vector<std::uint8_t>& fixed, const Im
   s = std::move(r);
   return true;
 }
+
 // Step 5: 2-3 / 3-2 flips around the slivers no vertex of which may move (Canny nodes: only the
 // connectivity can change there), then perturbation of the others' free vertices. False when
 // progress asked to abort.
