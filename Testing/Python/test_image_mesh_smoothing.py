@@ -1,5 +1,6 @@
 """Stage 3 on real data (nuclei, liver): a valid, exactly summarised mesh of better quality, Fixed
-nodes in place, box nodes on their faces, the same output across runs and thread counts."""
+nodes in place, box nodes on their faces, the same output across runs and thread counts; on
+BraTS-0005 (shared data, else skipped) the second refinement run that keeps the dihedral bound."""
 import sys
 
 import numpy as np
@@ -100,3 +101,18 @@ for case in CASES:
     one = ft.run_script_with_backend(__file__, "Sequential", case)
     two = ft.run_script_with_backend(__file__, "STDThread", case)
     ft.check(one == two == digest, "%s: identical with 1 thread (Sequential) and 2 threads (STDThread)" % case)
+
+# The second refinement run (docs/smoothing.md): at 4 sweeps TetGen's optimisation leaves a
+# tetrahedron of four Canny nodes at 8.7 degrees on BraTS-0005 that no flip improves; refinement
+# and sliver removal run again with TetGen's own target and the bound holds.
+case = "brain-tumour-brats-0005"
+if ft.fm.case_dir(case) is None:
+    print("SKIP %s: not found (bundled Data/ or ../shared/data/cases)" % case)
+else:
+    d, image, truth = ft.open_case(case)
+    out = ft.ImageMeshSmoothing(Mesh=ft.DelaunayImageMesh(Nodes=ft.FeatureNodes(Input=image), Image=image), Image=image, Iterations=4)
+    out.UpdatePipeline()
+    ug = ft.fetch(out)
+    q = metrics.mesh_quality(ft.v2n(ug.GetPoints().GetData()), cells(ug))
+    runs = ug.GetFieldData().GetArray(ft.names.RefinementRuns).GetValue(0)
+    ft.check(runs == 2 and q["min"] >= 10.0, "%s, 4 sweeps: %d refinement runs, smallest dihedral %.2f (>= 10)" % (case, runs, q["min"]))
