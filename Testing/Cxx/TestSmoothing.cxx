@@ -231,11 +231,7 @@ namespace
 // Signed volume of tetrahedron c of `cells`, index space.
 double TetVolume(const std::vector<std::array<double, 3>>& p, const std::vector<std::int64_t>& cells, size_t c)
 {
-  const auto& a = p[cells[4 * c]];
-  auto d = [&](int k, int x) { return p[cells[4 * c + k]][x] - a[x]; };
-  return (d(1, 0) * (d(2, 1) * d(3, 2) - d(2, 2) * d(3, 1)) - d(1, 1) * (d(2, 0) * d(3, 2) - d(2, 2) * d(3, 0)) +
-           d(1, 2) * (d(2, 0) * d(3, 1) - d(2, 1) * d(3, 0))) /
-    6.0;
+  return ElementMeasure(p, &cells[4 * c], 4);
 }
 
 // The faces with one tetrahedron (the boundary), as sorted vertex triples.

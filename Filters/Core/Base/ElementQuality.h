@@ -7,6 +7,7 @@
 #include "SimplexMesh.h"
 
 #include <array>
+#include <cmath>
 #include <vector>
 
 namespace featuremesh
@@ -23,4 +24,10 @@ double SimplexMinAngle(const std::array<double, 3>* const* v, int verticesPerCel
 // A cheap stand-in for SimplexMinAngle, monotone in it (no inverse cosine): minus the largest cosine
 // of the element's angles (triangle) or dihedral angles (tetrahedron); -cos(angle) at the angle.
 double SimplexAngleScore(const std::array<double, 3>* const* v, int verticesPerCell);
+
+// The SimplexAngleScore of an element whose smallest angle is `degrees`: a threshold on scores.
+inline double AngleScoreAt(double degrees)
+{
+  return -std::cos(degrees * 3.14159265358979323846 / 180.0);
+}
 } // namespace featuremesh

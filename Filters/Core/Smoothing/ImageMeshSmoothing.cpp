@@ -407,6 +407,15 @@ void ElementFrame(const Smoother& s, std::int64_t e, V3* frame, const V3** v)
   }
 }
 
+// SimplexAngleScore of tetrahedron e as the points stand.
+double ElementScore(const Smoother& s, std::int64_t e)
+{
+  V3 frame[4];
+  const V3* v[4];
+  ElementFrame(s, e, frame, v);
+  return SimplexAngleScore(v, 4);
+}
+
 // One free vertex of a sliver: the best of short steps (1/4, 1/8, 1/16 of its shortest edge) along
 // the slivers' opposite-face normals and the axes, taken when it raises its star's quality; true
 // when the vertex moved.
@@ -499,14 +508,9 @@ std::int64_t PerturbSlivers(Smoother& s, double sliverAngle, int passes, const P
   const std::int64_t m = s.Topology.NumberOfElements();
   const std::int64_t nPts = static_cast<std::int64_t>(s.Points.size());
   const CompressedRows& stars = s.Topology.Stars();
-  const double threshold = -std::cos(sliverAngle * 3.14159265358979323846 / 180.0);
+  const double threshold = AngleScoreAt(sliverAngle);
   // Sliver flags per element, kept current: only the stars of moved vertices change.
-  auto isSliver = [&](std::int64_t e) {
-    V3 frame[4];
-    const V3* v[4];
-    ElementFrame(s, e, frame, v);
-    return SimplexAngleScore(v, 4) < threshold;
-  };
+  auto isSliver = [&](std::int64_t e) { return ElementScore(s, e) < threshold; };
   std::vector<std::uint8_t> sliver(m);
   parallel(m, 4096, [&](std::int64_t b, std::int64_t e) {
     for (std::int64_t c = b; c < e; ++c)
@@ -976,13 +980,10 @@ bool RemoveSlivers(Smoother& s, double sliverAngle, const ParallelFor& parallel,
 // True when every element's smallest dihedral angle is at least `degrees`.
 bool ReachesAngle(const Smoother& s, double degrees)
 {
-  const double threshold = -std::cos(degrees * 3.14159265358979323846 / 180.0);
+  const double threshold = AngleScoreAt(degrees);
   for (std::int64_t e = 0; e < s.Topology.NumberOfElements(); ++e)
   {
-    V3 frame[4];
-    const V3* v[4];
-    ElementFrame(s, e, frame, v);
-    if (SimplexAngleScore(v, 4) < threshold)
+    if (ElementScore(s, e) < threshold)
     {
       return false;
     }

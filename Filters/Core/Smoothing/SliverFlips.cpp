@@ -4,7 +4,6 @@
 #include "ExactPredicates.h"
 
 #include <algorithm>
-#include <cmath>
 #include <numeric>
 
 namespace featuremesh
@@ -137,10 +136,7 @@ public:
       quality = std::min(quality, this->Quality(flip.New.back()));
     }
     flip.Quality = quality;
-    if (flip.Quality > best.Quality)
-    {
-      best = std::move(flip);
-    }
+    this->Consider(std::move(flip), best);
   }
 
   // 3-2: an interior edge of tetrahedron t with exactly three tetrahedra around it; they become two
@@ -183,7 +179,19 @@ public:
     flip.Old = ring;
     flip.New = { su > 0 ? Tet{ { a, b, d, u } } : Tet{ { b, a, d, u } }, sw > 0 ? Tet{ { a, b, d, w } } : Tet{ { b, a, d, w } } };
     flip.Quality = std::min(this->Quality(flip.New[0]), this->Quality(flip.New[1]));
-    if (flip.Quality > best.Quality)
+    this->Consider(std::move(flip), best);
+  }
+
+  // `flip` becomes the best when it raises the smallest angle of what it replaces, and more than
+  // the best so far does.
+  void Consider(Flip&& flip, Flip& best) const
+  {
+    double replaced = 1.0;
+    for (std::int64_t o : flip.Old)
+    {
+      replaced = std::min(replaced, this->Quality(this->Cell(o)));
+    }
+    if (flip.Quality > replaced && flip.Quality > best.Quality)
     {
       best = std::move(flip);
     }
@@ -201,7 +209,7 @@ std::int64_t FlipSlivers(const ImageGeometry& geometry, const std::vector<V3>& p
   double angle, int rounds, const std::vector<std::uint8_t>* movable)
 {
   Flipper f(geometry, points, cells);
-  const double threshold = -std::cos(angle * 3.14159265358979323846 / 180.0);
+  const double threshold = AngleScoreAt(angle);
   std::int64_t flips = 0;
   for (int round = 0; round < rounds; ++round)
   {
@@ -246,13 +254,7 @@ std::int64_t FlipSlivers(const ImageGeometry& geometry, const std::vector<V3>& p
           f.ThreeTwo(t, i, j, best);
         }
       }
-      // Taken when it raises the smallest angle of what it replaces.
-      double replaced = 1.0;
-      for (std::int64_t o : best.Old)
-      {
-        replaced = std::min(replaced, f.Quality(f.Cell(o)));
-      }
-      if (best.Old.empty() || !(best.Quality > replaced))
+      if (best.Old.empty())
       {
         continue;
       }
