@@ -6,9 +6,10 @@ the node points and arrays, of the mesh (points, cells, every cell array by valu
 voxel -> element map, of the smoothed mesh (stage 3 at its defaults, default backend) and its map, of the
 super-voxel labels (cells and label image), of Segmentation Surface Smoothing's output (the labelled
 mesh's points and the boundary's faces), of the voxel cut's labels and of RSP Edge Enhancement's
-outputs with the seed-aware nodes made from them (one line, last, so older digests compare line for line), at the default
+outputs with the seed-aware nodes made from them (one line, last per case, so older digests compare line for line), at the default
 properties (--cut overrides properties of both cuts, e.g. the defaults of an older commit); 3D cases
-also with the CGAL backend. Compare two runs with diff.
+also with the CGAL backend. Without --cases, the multi-label cases follow (labels, then two kept
+re-cuts, each after a seed added where the result is most wrong). Compare two runs with diff.
 """
 import argparse
 import hashlib
@@ -40,6 +41,37 @@ def owners(proxy):
     """The voxel -> element map a mesh proxy keeps (fm.owner_map), or "none"."""
     a = fm.owner_map(proxy)
     return sha(fm.v2n(a)) if a is not None else "none"
+
+
+def multilabel_lines(cut_properties):
+    """Each multi-label case's super-voxel labels (cells and label image), then after each of two
+    seeds added as benchmark_multilabel.py's robot user adds them (the kept re-cut)."""
+    import os
+    import tempfile
+    import paraview.simple as ps
+    from benchmark_multilabel import robot_seed, write_seeds
+    lines = []
+    for name, folder in fm.multilabel_cases().items():
+        case = fm.MultiLabelCase(folder)
+        image = fm.fetch(case.image)
+        dims = image.GetDimensions()
+        shape, spacing = (dims[2], dims[1], dims[0]), fm.np.asarray(image.GetSpacing())
+        truth, rows = case.truth(), case.seed_rows()
+        cut = case.super_voxel_cut(case.mesh(), **cut_properties)
+        with tempfile.TemporaryDirectory() as tmp:
+            for edit in range(3):
+                if edit:
+                    k, j, i, label = robot_seed(fm.labels(cut), truth, shape, spacing)
+                    rows = list(rows) + [image.GetPoint(image.ComputePointId([i, j, k])) + (label,)]
+                    path = os.path.join(tmp, "seeds%d.csv" % edit)
+                    write_seeds(path, rows)
+                    cut.Seeds = ps.CSVReader(FileName=[path])
+                cut.UpdatePipeline()
+                lines.append("%s multilabel %s %s" % (name, "labels" if edit == 0 else "recut%d" % edit,
+                                                      sha(fm.v2n(fm.fetch(cut, 0).GetCellData().GetArray(N.Label)),
+                                                          fm.v2n(fm.fetch(cut, 2).GetPointData().GetScalars()))))
+                print(lines[-1], flush=True)
+    return lines
 
 
 def main():
@@ -85,6 +117,8 @@ def main():
                                              fm.v2n(contour.GetPoints().GetData()) if contour.GetPoints() else [],
                                              fm.v2n(seeded.GetPoints().GetData()))))
         print(lines[-1], flush=True)
+    if not args.cases:
+        lines += multilabel_lines(cut_properties)
     text = "\n".join(lines) + "\n"
     print(text)
     if args.out:

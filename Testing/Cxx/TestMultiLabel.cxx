@@ -205,6 +205,70 @@ TEST(AlphaExpansion, HardLabelsHold)
   EXPECT_EQ(std::count(r.Label.begin(), r.Label.end(), 0), 23);
 }
 
+TEST(AlphaExpansion, RecycledMovesEqualFreshMoves)
+{
+  // A re-cut's edits on a grid and on a random graph: costs of one label everywhere, of every label
+  // on a few nodes, hard labels set and cleared, then the weights changed (the kept graphs start
+  // afresh), and an expansion aborted half way. Each time the recycled expansion, from the kept
+  // graphs, gives the fresh one's labels (random real costs: no move has tied cuts).
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<std::int64_t> a, b;
+  for (int e = 0; e < 1500; ++e)
+  {
+    const std::int64_t p = rng() % 400, q = rng() % 400;
+    if (p != q)
+    {
+      a.push_back(p);
+      b.push_back(q);
+    }
+  }
+  const GraphEdges grid = GraphEdges::Grid(20, 20, 1), random(a, b);
+  for (const GraphEdges* edges : { &grid, &random })
+    for (int labels : { 3, 5 })
+    {
+      PottsProblem pr;
+      pr.Nodes = 400;
+      pr.Labels = labels;
+      pr.Edges = edges;
+      for (std::int64_t e = 0; e < edges->Size(); ++e)
+        pr.Weight.push_back(0.5 + u(rng));
+      for (int i = 0; i < 400 * labels; ++i)
+        pr.Cost.push_back(3.0 * u(rng));
+      pr.Hard.assign(400, -1);
+      RecycledMoves recycled;
+      std::vector<std::uint8_t> start;
+      for (int edit = 0; edit < 8; ++edit)
+      {
+        if (edit == 6)
+        {
+          // Aborted after two moves: the kept graphs stay usable.
+          int calls = 0;
+          const ExpansionResult stopped =
+            AlphaExpansion(pr, start, [&](double) { return ++calls <= 2; }, 8, &recycled);
+          EXPECT_TRUE(stopped.Aborted);
+        }
+        const ExpansionResult kept = AlphaExpansion(pr, start, NoProgress(), 8, &recycled);
+        const ExpansionResult fresh = AlphaExpansion(pr, start, NoProgress(), 8);
+        ASSERT_TRUE(kept.Error.empty() && fresh.Error.empty()) << kept.Error << fresh.Error;
+        EXPECT_EQ(kept.Label, fresh.Label) << "edit " << edit << ", " << labels << " labels";
+        EXPECT_NEAR(kept.Energy, fresh.Energy, 1e-9 * std::fabs(fresh.Energy));
+        EXPECT_EQ(kept.Moves, fresh.Moves);
+        start = kept.Label;
+        const int l = static_cast<int>(rng() % labels);
+        for (int p = 0; p < 400; ++p)
+          pr.Cost[p * labels + l] *= 0.8 + 0.4 * u(rng);
+        for (int i = 0; i < 20; ++i)
+          pr.Cost[(rng() % 400) * labels + rng() % labels] = 3.0 * u(rng);
+        pr.Hard[rng() % 400] = static_cast<std::int16_t>(rng() % labels);
+        pr.Hard[rng() % 400] = -1;
+        if (edit == 4)
+          for (double& w : pr.Weight)
+            w *= 0.5 + u(rng);
+      }
+    }
+}
+
 TEST(AlphaExpansion, BadProblemsAreErrors)
 {
   const GraphEdges edges = GraphEdges::Grid(2, 2, 1);
@@ -413,6 +477,39 @@ TEST(MultiLabel, TheGeodesicTermFindsWhatTheHistogramsCannot)
         EXPECT_LT(filled(*label), 0.1) << (label == &super ? "elements" : "voxels");
     }
   }
+}
+
+TEST(MultiLabel, AKeptReCutEqualsAFreshOne)
+{
+  // Three noisy plateaus on the elements, Task Object; seeds added one at a time, each cut keeping
+  // what the last one kept (distances, spatial term, weights, move graphs). From the same start
+  // labels, a cut with nothing kept gives the same labels and energy.
+  Plateaus p;
+  Lattice m;
+  ASSERT_TRUE(m.Make(p.G, p.Image, 1));
+  SuperVoxelCutParameters par;
+  MultiLabelCache kept;
+  LabelledSeeds seeds;
+  for (int s : { 0, 3, 6, 1, 4, 7, 2 })
+  {
+    seeds.Voxel.push_back(p.Seeds.Voxel[s]);
+    seeds.Label.push_back(p.Seeds.Label[s]);
+    if (seeds.Voxel.size() < 3)
+      continue;
+    MultiLabelCache fresh;
+    fresh.Label = kept.Label;
+    const MultiLabelResult a = MultiLabelSuperVoxelCut(m.Mesh, m.Data, m.Bins, m.Runs, m.Mean, m.Count, seeds, par,
+      MultiLabelParameters(), SerialFor(), NoProgress(), &kept);
+    const MultiLabelResult b = MultiLabelSuperVoxelCut(m.Mesh, m.Data, m.Bins, m.Runs, m.Mean, m.Count, seeds, par,
+      MultiLabelParameters(), SerialFor(), NoProgress(), &fresh);
+    ASSERT_TRUE(a.Error.empty() && b.Error.empty()) << a.Error << b.Error;
+    EXPECT_EQ(a.Label, b.Label) << seeds.Voxel.size() << " seeds";
+    EXPECT_NEAR(a.Energy, b.Energy, 1e-9 * std::fabs(b.Energy));
+    EXPECT_EQ(a.Moves, b.Moves);
+  }
+  std::vector<std::uint8_t> pixels(p.G.Size(), 0);
+  VoxelLabels(m.Data.Owner, kept.Label, pixels.data(), SerialFor());
+  EXPECT_GT(p.Correct(pixels), 0.95);
 }
 
 TEST(MultiLabel, ConnectivityGivesAnUnseededPieceToItsNeighbour)

@@ -134,11 +134,11 @@ double EnergyBound(const PottsProblem& pr)
 
 // Each node's summed boundary weight (Reach: the most a move's pairwise terms can reward it for
 // switching), and its neighbours with the edges' weights in compressed rows (First), to price a
-// move by the nodes it moved.
+// move by the nodes it moved. Side: 2 e when the node is edge e's first end, 2 e + 1 its second.
 struct Neighbourhood
 {
   std::vector<double> Reach, Weight;
-  std::vector<std::int64_t> First, Neighbour;
+  std::vector<std::int64_t> First, Neighbour, Side;
   explicit Neighbourhood(const PottsProblem& pr)
     : Reach(pr.Nodes, 0.0)
     , First(pr.Nodes + 1, 0)
@@ -156,15 +156,43 @@ struct Neighbourhood
     }
     this->Neighbour.resize(this->First[n]);
     this->Weight.resize(this->First[n]);
+    this->Side.resize(this->First[n]);
     std::vector<std::int64_t> at(this->First.begin(), this->First.end() - 1);
     pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
+      this->Side[at[p]] = 2 * k;
       this->Neighbour[at[p]] = q;
       this->Weight[at[p]++] = pr.Weight[k];
+      this->Side[at[q]] = 2 * k + 1;
       this->Neighbour[at[q]] = p;
       this->Weight[at[q]++] = pr.Weight[k];
     });
   }
 };
+
+// A move's energy change, from the nodes it switched and their edges (an edge between two switched
+// nodes counted once); moved(q) tells whether q is one of them.
+template <typename Moved>
+double MoveChange(const PottsProblem& pr, int alpha, const std::vector<std::uint8_t>& label, const Neighbourhood& around,
+  const std::vector<std::int64_t>& switched, Moved&& moved)
+{
+  const int L = pr.Labels;
+  double change = 0.0;
+  for (const std::int64_t p : switched)
+  {
+    change += pr.Cost[p * L + alpha] - pr.Cost[p * L + label[p]];
+    for (std::int64_t j = around.First[p]; j < around.First[p + 1]; ++j)
+    {
+      const std::int64_t q = around.Neighbour[j];
+      const bool both = moved(q);
+      if (both && q < p)
+      {
+        continue;
+      }
+      change += around.Weight[j] * ((both ? 0 : alpha != label[q]) - (label[p] != label[q] ? 1.0 : 0.0));
+    }
+  }
+  return change;
+}
 
 // One alpha-expansion move on the graph g (reset here): the nodes it switches to alpha and the
 // energy change. Node p keeps its label and pays keep[p] (source segment), or takes alpha and pays
@@ -250,29 +278,341 @@ double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::u
       switched.push_back(p);
     }
   }
-  // The move's energy change, from the nodes it switched and their edges (an edge between two
-  // switched nodes counted once).
-  double change = 0.0;
-  for (const std::int64_t p : switched)
+  return MoveChange(pr, alpha, label, around, switched,
+    [&](std::int64_t q) { return id[q] >= 0 && g.what_segment(id[q]) == Flow::SINK; });
+}
+
+// A label's kept move graph: every node and edge, with the labels, terminal terms (take - keep) and
+// edge capacities it was last set for; the nodes whose label or hard label changed since (their
+// edges change) and those whose cost of alpha or of their label did (their terminal term changes);
+// the free nodes in the sink segment of its last max-flow (Sink, listed in SinkList).
+struct LabelGraph
+{
+  std::unique_ptr<Flow> G;
+  std::unique_ptr<maxflow::Block<int>> Changed; // libmaxflow's nodes whose segment may have changed
+  std::vector<std::uint8_t> Label, Sink;
+  std::vector<double> Net, Cap; // Cap[2 e], Cap[2 e + 1]: edge e's first -> second end, and back
+  std::vector<std::int64_t> Relabelled, CostChanged, SinkList;
+  bool Built = false;
+};
+} // namespace
+
+struct RecycledMoves::State
+{
+  std::int64_t Nodes = 0;
+  int Labels = 0;
+  GraphEdges Edges;
+  std::vector<double> Weight, Cost;
+  std::vector<std::int16_t> Hard;
+  std::vector<std::uint8_t> Label; // after the last move
+  std::unique_ptr<Neighbourhood> Around;
+  std::vector<LabelGraph> Graph;
+  std::vector<std::uint32_t> Stamp; // a node's last visit, to visit each once per move
+  std::uint32_t Visit = 0;
+};
+
+RecycledMoves::RecycledMoves() = default;
+RecycledMoves::~RecycledMoves() = default;
+RecycledMoves::RecycledMoves(RecycledMoves&&) noexcept = default;
+RecycledMoves& RecycledMoves::operator=(RecycledMoves&&) noexcept = default;
+void RecycledMoves::Clear()
+{
+  this->Kept.reset();
+}
+
+namespace
+{
+// What the kept graphs of all labels take: libmaxflow's 48-byte nodes and 32-byte arcs, and the
+// labels, terms and capacities each is set for.
+std::int64_t RecycledBytes(std::int64_t nodes, std::int64_t edges, int labels)
+{
+  return labels * (nodes * (48 + 8 + 2) + edges * 2 * (32 + 8));
+}
+
+// Nodes whose label changed: every built graph updates them at its next move.
+void RecordRelabelled(RecycledMoves::State& st, const std::vector<std::int64_t>& nodes)
+{
+  for (LabelGraph& g : st.Graph)
   {
-    change += pr.Cost[p * L + alpha] - pr.Cost[p * L + label[p]];
-    for (std::int64_t j = around.First[p]; j < around.First[p + 1]; ++j)
+    if (g.Built)
     {
-      const std::int64_t q = around.Neighbour[j];
-      const bool both = id[q] >= 0 && g.what_segment(id[q]) == Flow::SINK;
-      if (both && q < p)
-      {
-        continue;
-      }
-      change += around.Weight[j] * ((both ? 0 : alpha != label[q]) - (label[p] != label[q] ? 1.0 : 0.0));
+      g.Relabelled.insert(g.Relabelled.end(), nodes.begin(), nodes.end());
     }
   }
-  return change;
+}
+
+// The kept state for this problem and the labels the moves start from (null when its graphs would
+// not fit the budget): started afresh for another graph, weights or label count, else told which
+// nodes' labels, costs or hard labels changed.
+RecycledMoves::State* SyncRecycled(RecycledMoves& recycled, const PottsProblem& pr, const std::vector<std::uint8_t>& label)
+{
+  const std::int64_t n = pr.Nodes, m = pr.Edges->Size();
+  const int L = pr.Labels;
+  if (RecycledBytes(n, m, L) > RecycledMoves::Budget)
+  {
+    recycled.Clear();
+    return nullptr;
+  }
+  std::unique_ptr<RecycledMoves::State>& k = recycled.Kept;
+  if (!k || k->Nodes != n || k->Labels != L || !k->Edges.Same(*pr.Edges) || k->Weight != pr.Weight)
+  {
+    k.reset(new RecycledMoves::State);
+    k->Nodes = n;
+    k->Labels = L;
+    if (pr.Edges->IsGrid() || pr.Edges->Held())
+    {
+      k->Edges = *pr.Edges;
+    }
+    else
+    {
+      k->Edges = GraphEdges::Owned(std::vector<std::int64_t>(pr.Edges->First(), pr.Edges->First() + m),
+        std::vector<std::int64_t>(pr.Edges->Second(), pr.Edges->Second() + m));
+    }
+    k->Weight = pr.Weight;
+    k->Cost = pr.Cost;
+    k->Hard = pr.Hard.empty() ? std::vector<std::int16_t>(n, -1) : pr.Hard;
+    k->Label = label;
+    k->Around.reset(new Neighbourhood(pr));
+    k->Graph.resize(L);
+    k->Stamp.assign(n, 0);
+    return k.get();
+  }
+  // Nodes whose label or hard label changed, and which of each node's label costs did (bit l for
+  // label l, bit 63 for every label from 63 on).
+  std::vector<std::int64_t> relabelled, costChanged;
+  std::vector<std::uint64_t> which;
+  const auto bit = [](int l) { return std::uint64_t(1) << std::min(l, 63); };
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    const std::int16_t h = HardLabel(pr, p);
+    const double* c = &pr.Cost[p * L];
+    double* was = &k->Cost[p * L];
+    if (h != k->Hard[p] || label[p] != k->Label[p])
+    {
+      relabelled.push_back(p);
+      k->Hard[p] = h;
+      k->Label[p] = label[p];
+    }
+    if (!std::equal(c, c + L, was))
+    {
+      costChanged.push_back(p);
+      which.push_back(0);
+      for (int l = 0; l < L; ++l)
+      {
+        which.back() |= c[l] != was[l] ? bit(l) : 0;
+      }
+      std::copy(c, c + L, was);
+    }
+  }
+  RecordRelabelled(*k, relabelled);
+  for (int alpha = 0; alpha < L; ++alpha)
+  {
+    LabelGraph& g = k->Graph[alpha];
+    for (std::size_t i = 0; i < costChanged.size() && g.Built; ++i)
+    {
+      if (which[i] & (bit(alpha) | bit(g.Label[costChanged[i]])))
+      {
+        g.CostChanged.push_back(costChanged[i]);
+      }
+    }
+    g.Built = g.Built && static_cast<std::int64_t>(g.Relabelled.size() + g.CostChanged.size()) <= 2 * n;
+  }
+  return k.get();
+}
+
+// The move of alpha on its kept graph: built at its first move, later updated where the nodes' labels
+// changed (their edges, and their and their neighbours' terminal terms) or their costs did, and its
+// max-flow run on from the last one's (libmaxflow's reused search trees). An edge whose flow exceeds
+// its new capacity sends the excess back through the terminals (Kohli & Torr's reparameterisation).
+// The same move as ExpansionMove, with every node in the graph: fixed ones stay isolated.
+double RecycledMove(const PottsProblem& pr, int alpha, const std::vector<std::uint8_t>& label, RecycledMoves::State& st,
+  std::vector<std::int64_t>& switched)
+{
+  const std::int64_t n = pr.Nodes, m = pr.Edges->Size();
+  const int L = pr.Labels;
+  const Neighbourhood& around = *st.Around;
+  const std::vector<std::int16_t>& hard = st.Hard;
+  LabelGraph& lg = st.Graph[alpha];
+  const auto fixed = [&](std::int64_t p) { return label[p] == alpha || hard[p] >= 0; };
+  const auto net = [&](std::int64_t p) {
+    if (fixed(p))
+    {
+      return 0.0;
+    }
+    const int a = label[p];
+    double keep = pr.Cost[p * L + a], take = pr.Cost[p * L + alpha];
+    for (std::int64_t j = around.First[p]; j < around.First[p + 1]; ++j)
+    {
+      const int b = label[around.Neighbour[j]];
+      if (fixed(around.Neighbour[j]))
+      {
+        keep += a != b ? around.Weight[j] : 0.0;
+        take += alpha != b ? around.Weight[j] : 0.0;
+      }
+      else if (a != b && (around.Side[j] & 1))
+      {
+        keep += around.Weight[j];
+      }
+    }
+    return take - keep;
+  };
+  const auto capacities = [&](std::int64_t p, std::int64_t q, double w, double& c1, double& c2) {
+    c1 = fixed(p) || fixed(q) ? 0.0 : w;
+    c2 = fixed(p) || fixed(q) || label[p] != label[q] ? 0.0 : w;
+  };
+  // A node's segment as the move reads it: free and on the sink side.
+  const auto recheck = [&](std::int64_t p) {
+    const bool sink = !fixed(p) && lg.G->what_segment(static_cast<int>(p)) == Flow::SINK;
+    if (sink && !lg.Sink[p])
+    {
+      lg.SinkList.push_back(p);
+    }
+    lg.Sink[p] = sink;
+  };
+  if (!lg.Built)
+  {
+    if (!lg.G)
+    {
+      lg.G.reset(new Flow(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory));
+      lg.Changed.reset(new maxflow::Block<int>(4096));
+    }
+    Flow& g = *lg.G;
+    g.reset();
+    g.add_node(static_cast<int>(n));
+    lg.Cap.resize(2 * m);
+    lg.Net.resize(n);
+    pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
+      capacities(p, q, pr.Weight[k], lg.Cap[2 * k], lg.Cap[2 * k + 1]);
+      g.add_edge(static_cast<int>(p), static_cast<int>(q), lg.Cap[2 * k], lg.Cap[2 * k + 1]);
+    });
+    for (std::int64_t p = 0; p < n; ++p)
+    {
+      lg.Net[p] = net(p);
+      g.add_tweights(static_cast<int>(p), std::max(lg.Net[p], 0.0), std::max(-lg.Net[p], 0.0));
+    }
+    lg.Label = label;
+    lg.Relabelled.clear();
+    lg.CostChanged.clear();
+    lg.Built = true;
+    g.maxflow(false);
+    lg.Sink.assign(n, 0);
+    lg.SinkList.clear();
+    for (std::int64_t p = 0; p < n; ++p)
+    {
+      recheck(p);
+    }
+  }
+  else
+  {
+    Flow& g = *lg.G;
+    // Only a change of sign of a node's terminal residual, or of an arc's between zero and not,
+    // can change the search trees: the other nodes are not marked (libmaxflow's mark_node).
+    const auto sign = [](double v) { return (v > 0.0) - (v < 0.0); };
+    const auto addTerminal = [&](std::int64_t p, double source, double sink) {
+      const int before = sign(g.get_trcap(static_cast<int>(p)));
+      g.add_tweights(static_cast<int>(p), source, sink);
+      if (sign(g.get_trcap(static_cast<int>(p))) != before)
+      {
+        g.mark_node(static_cast<int>(p));
+      }
+    };
+    if (++st.Visit == 0)
+    {
+      std::fill(st.Stamp.begin(), st.Stamp.end(), 0);
+      st.Visit = 1;
+    }
+    std::vector<std::int64_t> touched;
+    const auto touch = [&](std::int64_t p) {
+      if (st.Stamp[p] != st.Visit)
+      {
+        st.Stamp[p] = st.Visit;
+        touched.push_back(p);
+      }
+    };
+    const Flow::arc_id arcs = g.get_first_arc();
+    for (const std::int64_t p : lg.Relabelled)
+    {
+      lg.Label[p] = label[p];
+      touch(p);
+      for (std::int64_t j = around.First[p]; j < around.First[p + 1]; ++j)
+      {
+        const std::int64_t q = around.Neighbour[j], k = around.Side[j] >> 1;
+        touch(q);
+        const bool second = around.Side[j] & 1;
+        const std::int64_t a = second ? q : p, b = second ? p : q;
+        double c1, c2;
+        capacities(a, b, around.Weight[j], c1, c2);
+        if (c1 == lg.Cap[2 * k] && c2 == lg.Cap[2 * k + 1])
+        {
+          continue;
+        }
+        const double was1 = g.get_rcap(arcs + 2 * k), was2 = g.get_rcap(arcs + 2 * k + 1);
+        const double flow = lg.Cap[2 * k] - was1;
+        double r1 = c1 - flow, r2 = c2 + flow;
+        if (r1 < 0.0)
+        {
+          addTerminal(a, -r1, 0.0);
+          addTerminal(b, 0.0, -r1);
+          r1 = 0.0;
+          r2 = c1 + c2;
+        }
+        else if (r2 < 0.0)
+        {
+          addTerminal(b, -r2, 0.0);
+          addTerminal(a, 0.0, -r2);
+          r2 = 0.0;
+          r1 = c1 + c2;
+        }
+        g.set_rcap(arcs + 2 * k, r1);
+        g.set_rcap(arcs + 2 * k + 1, r2);
+        lg.Cap[2 * k] = c1;
+        lg.Cap[2 * k + 1] = c2;
+        if ((was1 > 0.0) != (r1 > 0.0) || (was2 > 0.0) != (r2 > 0.0))
+        {
+          g.mark_node(static_cast<int>(a));
+          g.mark_node(static_cast<int>(b));
+        }
+      }
+    }
+    for (const std::int64_t p : lg.CostChanged)
+    {
+      touch(p);
+    }
+    for (const std::int64_t p : touched)
+    {
+      const double t = net(p);
+      if (t != lg.Net[p])
+      {
+        addTerminal(p, t - lg.Net[p], 0.0);
+        lg.Net[p] = t;
+      }
+    }
+    g.maxflow(true, lg.Changed.get());
+    // Segments change only for libmaxflow's listed nodes; fixed or freed nodes are relabelled ones.
+    for (int* i = lg.Changed->ScanFirst(); i; i = lg.Changed->ScanNext())
+    {
+      g.remove_from_changed_list(*i);
+      recheck(*i);
+    }
+    lg.Changed->Reset();
+    for (const std::int64_t p : lg.Relabelled)
+    {
+      recheck(p);
+    }
+    lg.Relabelled.clear();
+    lg.CostChanged.clear();
+  }
+  // The sink list without the nodes that left it.
+  lg.SinkList.erase(std::remove_if(lg.SinkList.begin(), lg.SinkList.end(), [&](std::int64_t p) { return !lg.Sink[p]; }),
+    lg.SinkList.end());
+  switched = lg.SinkList;
+  std::sort(switched.begin(), switched.end());
+  return MoveChange(pr, alpha, label, around, switched, [&](std::int64_t q) { return lg.Sink[q] != 0; });
 }
 } // namespace
 
 ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t> label, const ProgressFunction& progress,
-  int maxCycles)
+  int maxCycles, RecycledMoves* recycled)
 {
   ExpansionResult r;
   r.Error = Validate(pr);
@@ -290,10 +630,12 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
   }
   const std::int64_t m = pr.Edges->Size();
   double energy = PottsEnergy(pr, label);
-  const Neighbourhood around(pr);
   try
   {
-    Flow g(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory);
+    RecycledMoves::State* kept = recycled ? SyncRecycled(*recycled, pr, label) : nullptr;
+    std::unique_ptr<Neighbourhood> own(kept ? nullptr : new Neighbourhood(pr));
+    const Neighbourhood& around = kept ? *kept->Around : *own;
+    std::unique_ptr<Flow> g(kept ? nullptr : new Flow(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory));
     const int total = std::max(1, maxCycles) * L;
     std::vector<std::int64_t> switched;
     MoveBuffers buffers;
@@ -309,12 +651,21 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
           r.Aborted = true;
           return r;
         }
-        const double change = ExpansionMove(pr, alpha, label, around, g, buffers, switched);
+        const double change = kept ? RecycledMove(pr, alpha, label, *kept, switched)
+                                   : ExpansionMove(pr, alpha, label, around, *g, buffers, switched);
         if (!switched.empty() && change < -1e-9 * std::max(1.0, std::fabs(energy)))
         {
           for (const std::int64_t p : switched)
           {
             label[p] = static_cast<std::uint8_t>(alpha);
+          }
+          if (kept)
+          {
+            for (const std::int64_t p : switched)
+            {
+              kept->Label[p] = static_cast<std::uint8_t>(alpha);
+            }
+            RecordRelabelled(*kept, switched);
           }
           energy += change;
           ++r.Moves;
@@ -325,6 +676,10 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
   }
   catch (const std::exception&)
   {
+    if (recycled)
+    {
+      recycled->Clear();
+    }
     r.Error = "not enough memory for the max-flow graph (" + std::to_string(n) + " nodes, " + std::to_string(m) + " edges).";
     return r;
   }

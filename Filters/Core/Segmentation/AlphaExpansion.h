@@ -12,6 +12,7 @@
 #include "Parallel.h"
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -37,12 +38,32 @@ struct ExpansionResult
   bool Aborted = false;
 };
 
+// Each label's move graph with its flow, kept from one expansion to the next ("recycling", Alahari,
+// Kohli & Torr, PAMI 2010, after Kohli & Torr's dynamic graph cuts): a move is then the last move of
+// its label updated where labels, costs or hard labels changed since, and its max-flow starts from
+// the last one's. Kept only while the graphs of all labels fit in Budget bytes; a change of the
+// graph, its weights or the label count starts afresh.
+class RecycledMoves
+{
+public:
+  static constexpr std::int64_t Budget = std::int64_t(1) << 30;
+  RecycledMoves();
+  ~RecycledMoves();
+  RecycledMoves(RecycledMoves&&) noexcept;
+  RecycledMoves& operator=(RecycledMoves&&) noexcept;
+  void Clear();
+  struct State;
+  std::unique_ptr<State> Kept;
+};
+
 // The energy of `label` (hard constraints not checked).
 double PottsEnergy(const PottsProblem& problem, const std::vector<std::uint8_t>& label);
 
 // From `start` (empty: each node's hard label, else its cheapest), at most `maxCycles` cycles.
 // Every input is checked first (finite costs and weights, edges naming nodes, hard labels in
 // range): a problem is an Error sentence. Progress after each move; an abort leaves Aborted.
+// With `recycled`, each label's move graph is kept and updated (above) instead of built anew; each
+// move is the same exact optimum, so the result differs only where a move has tied cuts.
 ExpansionResult AlphaExpansion(const PottsProblem& problem, std::vector<std::uint8_t> start,
-  const ProgressFunction& progress = NoProgress(), int maxCycles = 8);
+  const ProgressFunction& progress = NoProgress(), int maxCycles = 8, RecycledMoves* recycled = nullptr);
 } // namespace featuremesh

@@ -193,9 +193,32 @@ bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, 
   {
     return false;
   }
+  // A node's term is redone only when one of its distances changed since the kept cut's.
+  GeodesicTerm* kept = cache ? &cache->Term : nullptr;
+  const bool reuse = kept && kept->Labels == L && kept->Weight == geo.Weight && kept->Lambda == lambda &&
+    kept->Size == size && kept->Distance.size() == distance.size();
+  if (kept && !reuse)
+  {
+    kept->Labels = L;
+    kept->Weight = geo.Weight;
+    kept->Lambda = lambda;
+    kept->Size = size;
+    kept->Term.assign(n * L, 0.0);
+  }
+  std::vector<double> own(kept ? 0 : n * L);
+  std::vector<double>& term = kept ? kept->Term : own;
   const double mix = 0.01;
   for (std::int64_t p = 0; p < n; ++p)
   {
+    bool same = reuse;
+    for (int l = 0; l < L && same; ++l)
+    {
+      same = distance[l][p] == kept->Distance[l][p];
+    }
+    if (same)
+    {
+      continue;
+    }
     double total = 0.0;
     int zeros = 0;
     for (int l = 0; l < L; ++l)
@@ -210,8 +233,16 @@ bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, 
       const double d = distance[l][p];
       const double share = zeros ? (d == 0.0 ? 1.0 / zeros : 0.0)
                                  : (total > 0.0 ? (std::isfinite(d) ? 1.0 / d / total : 0.0) : 1.0 / L);
-      cost[p * L + l] += s * -geo.Weight * std::log(mix + (1.0 - L * mix) * share);
+      term[p * L + l] = s * -geo.Weight * std::log(mix + (1.0 - L * mix) * share);
     }
+  }
+  for (std::int64_t i = 0; i < n * L; ++i)
+  {
+    cost[i] += term[i];
+  }
+  if (kept)
+  {
+    kept->Distance = distance;
   }
   return true;
 }
@@ -276,11 +307,25 @@ void SolveLabels(PottsProblem& pr, std::vector<std::int16_t> hard, const std::ve
     r.GeodesicSeconds = Since(g0);
   }
   r.Sigma = par.Sigma;
-  pr.Weight = PottsWeights(edges, mean, bins.Channels, contact, r.Sigma);
+  if (cache && static_cast<std::int64_t>(cache->Weight.size()) == edges.Size())
+  {
+    pr.Weight = cache->Weight;
+    r.Sigma = cache->Sigma;
+  }
+  else
+  {
+    pr.Weight = PottsWeights(edges, mean, bins.Channels, contact, r.Sigma);
+  }
+  if (cache)
+  {
+    cache->Weight = pr.Weight;
+    cache->Sigma = r.Sigma;
+  }
   pr.Hard = hard;
   r.SetupSeconds = Since(t0);
   const auto t1 = Clock::now();
-  ExpansionResult x = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.2, 0.95), multi.MaxCycles);
+  ExpansionResult x = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.2, 0.95), multi.MaxCycles,
+    cache ? &cache->Moves : nullptr);
   r.ExpansionSeconds = Since(t1);
   if (!x.Error.empty() || x.Aborted)
   {
@@ -585,28 +630,51 @@ std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>
   {
     return 0;
   }
+  // The components of equal label once; then whole components are relabelled and joined, over the
+  // edges between them.
   const std::int64_t n = static_cast<std::int64_t>(label.size());
+  std::int64_t count = 0;
+  const std::vector<std::int64_t> comp = LabelComponents(label, edges, count);
+  std::vector<std::int64_t> root(count), size(count, 0);
+  std::iota(root.begin(), root.end(), std::int64_t(0));
+  std::vector<std::uint8_t> group(count, 0), seeded(count, 0), touches(count, 0);
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    group[comp[p]] = label[p];
+    seeded[comp[p]] |= hard[p] == label[p];
+    touches[comp[p]] |= border[p];
+    ++size[comp[p]];
+  }
+  struct Between
+  {
+    std::int64_t A, B;
+    double W;
+  };
+  std::vector<Between> between;
+  edges.ForEach([&](std::int64_t e, std::int64_t a, std::int64_t b) {
+    if (comp[a] != comp[b])
+    {
+      between.push_back({ comp[a], comp[b], weight.empty() ? 1.0 : weight[e] + 1e-300 });
+    }
+  });
+  const auto find = [&](std::int64_t c) {
+    while (root[c] != c)
+    {
+      c = root[c] = root[root[c]];
+    }
+    return c;
+  };
   std::int64_t changed = 0;
   // A dropped component may border only dropped ones: a second pass takes what the first settled.
   for (int pass = 0; pass < 3; ++pass)
   {
-    std::int64_t count = 0;
-    const std::vector<std::int64_t> comp = LabelComponents(label, edges, count);
-    std::vector<std::uint8_t> seeded(count, 0), touches(count, 0);
-    for (std::int64_t p = 0; p < n; ++p)
-    {
-      seeded[comp[p]] |= hard[p] == label[p];
-      touches[comp[p]] |= border[p];
-    }
     std::vector<std::uint8_t> drop(count, 0);
-    std::int64_t any = 0;
-    for (std::int64_t p = 0; p < n; ++p)
+    bool any = false;
+    for (std::int64_t c = 0; c < count; ++c)
     {
-      const std::int64_t c = comp[p];
-      const bool d = !seeded[c] &&
-        ((label[p] == 0 && !touches[c]) || (label[p] != 0 && mode == Connectivity::SeededObject));
-      drop[c] = d;
-      any += d;
+      drop[c] = root[c] == c && !seeded[c] &&
+        ((group[c] == 0 && !touches[c]) || (group[c] != 0 && mode == Connectivity::SeededObject));
+      any = any || drop[c];
     }
     if (!any)
     {
@@ -614,22 +682,22 @@ std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>
     }
     // Per dropped component, the shared weight with each kept neighbouring label.
     std::map<std::pair<std::int64_t, int>, double> shared;
-    edges.ForEach([&](std::int64_t e, std::int64_t a, std::int64_t b) {
-      const std::int64_t ca = comp[a], cb = comp[b];
+    for (const Between& e : between)
+    {
+      const std::int64_t ca = find(e.A), cb = find(e.B);
       if (ca == cb)
       {
-        return;
+        continue;
       }
-      const double w = weight.empty() ? 1.0 : weight[e] + 1e-300;
       if (drop[ca] && !drop[cb])
       {
-        shared[{ ca, label[b] }] += w;
+        shared[{ ca, group[cb] }] += e.W;
       }
       if (drop[cb] && !drop[ca])
       {
-        shared[{ cb, label[a] }] += w;
+        shared[{ cb, group[ca] }] += e.W;
       }
-    });
+    }
     std::vector<int> to(count, -1);
     std::vector<double> best(count, -1.0);
     for (const auto& s : shared)
@@ -641,13 +709,12 @@ std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>
       }
     }
     std::int64_t moved = 0;
-    for (std::int64_t p = 0; p < n; ++p)
+    for (std::int64_t c = 0; c < count; ++c)
     {
-      const int t = to[comp[p]];
-      if (drop[comp[p]] && t >= 0 && t != label[p])
+      if (drop[c] && to[c] >= 0 && to[c] != group[c])
       {
-        label[p] = static_cast<std::uint8_t>(t);
-        ++moved;
+        group[c] = static_cast<std::uint8_t>(to[c]);
+        moved += size[c];
       }
     }
     changed += moved;
@@ -655,6 +722,26 @@ std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>
     {
       break;
     }
+    // Components of one label that now touch are one.
+    for (const Between& e : between)
+    {
+      std::int64_t ca = find(e.A), cb = find(e.B);
+      if (ca != cb && group[ca] == group[cb])
+      {
+        if (cb < ca)
+        {
+          std::swap(ca, cb);
+        }
+        root[cb] = ca;
+        size[ca] += size[cb];
+        seeded[ca] |= seeded[cb];
+        touches[ca] |= touches[cb];
+      }
+    }
+  }
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    label[p] = group[find(comp[p])];
   }
   return changed;
 }
@@ -718,7 +805,8 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
       }
     }
   });
-  const std::vector<double> step = data.CentreSteps.size() == faces->A.size() ? data.CentreSteps : CentreDistances(mesh, *faces);
+  const std::vector<double> ownStep = data.CentreSteps.size() == faces->A.size() ? std::vector<double>() : CentreDistances(mesh, *faces);
+  const std::vector<double>& step = ownStep.empty() ? data.CentreSteps : ownStep;
   std::vector<std::uint8_t> border(n, 0);
   for (std::int64_t e : faces->HullElement)
   {
@@ -733,8 +821,16 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
       l = l < L ? l : 0;
     }
   }
-  SolveLabels(pr, hard, mean, bins, &step, ContactInVoxelFaces(mesh, par.ScaleByContact), count, border, par, multi,
-    std::move(start), progress, cache, t0, r);
+  // The weights depend on the mesh, the image and these two parameters only: a re-cut keeps them.
+  if (cache && (cache->WeightSigma != par.Sigma || cache->WeightContact != par.ScaleByContact))
+  {
+    cache->Weight.clear();
+    cache->WeightSigma = par.Sigma;
+    cache->WeightContact = par.ScaleByContact;
+  }
+  const bool weighted = cache && static_cast<std::int64_t>(cache->Weight.size()) == edges.Size();
+  SolveLabels(pr, hard, mean, bins, &step, weighted ? std::vector<double>() : ContactInVoxelFaces(mesh, par.ScaleByContact),
+    count, border, par, multi, std::move(start), progress, cache, t0, r);
   if (!r.Error.empty() || r.Aborted)
   {
     return r;

@@ -108,16 +108,36 @@ struct MultiLabelResult
   bool Aborted = false;
 };
 
+// The seeds' spatial term of the last cut per node and label (nodes x labels), with the distances,
+// label count, weight, lambda and node sizes it was made from.
+struct GeodesicTerm
+{
+  std::vector<std::vector<double>> Distance;
+  std::vector<double> Term, Size;
+  double Weight = 0.0, Lambda = 0.0;
+  int Labels = 0;
+};
+
 // What a multi-label cut of one graph keeps for the next: the last labelling (the next cut starts
-// from it) and its seeds' geodesic distances per label (updated, not redone, after a seed edit).
+// from it), its seeds' geodesic distances per label (updated, not redone, after a seed edit) and
+// each label's move graph with its flow.
 struct MultiLabelCache
 {
   std::vector<std::uint8_t> Label;
   SeedGeodesicCache Geodesic;
+  GeodesicTerm Term;
+  RecycledMoves Moves;
+  // The Potts weights, for the Sigma and ScaleByContact they were made with, and the sigma used.
+  std::vector<double> Weight;
+  double WeightSigma = -1.0, Sigma = 0.0;
+  bool WeightContact = false;
   void Clear()
   {
     this->Label.clear();
     this->Geodesic.Clear();
+    this->Term = GeodesicTerm();
+    this->Moves.Clear();
+    this->Weight.clear();
   }
 };
 
