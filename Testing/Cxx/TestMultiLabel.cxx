@@ -705,7 +705,7 @@ TEST(MultiLabel, KeptDistancesOfEveryLabelEqualFreshOnes)
   hard[g.Index(3, 3, 0)] = 1;
   hard[g.Index(30, 20, 0)] = 2;
   hard[g.Index(20, 5, 0)] = 3;
-  SeedGeodesicCache cache;
+  SeedGeodesicCache cache, threaded;
   const std::vector<std::vector<std::pair<int, int>>> edits = {
     {}, { { g.Index(10, 10, 0), 1 } }, { { g.Index(3, 3, 0), 0 } }, { { g.Index(25, 25, 0), 3 }, { g.Index(20, 5, 0), 0 } },
     { { g.Index(30, 20, 0), 0 }, { g.Index(31, 20, 0), 2 } }, {}
@@ -716,6 +716,8 @@ TEST(MultiLabel, KeptDistancesOfEveryLabelEqualFreshOnes)
       hard[e.first] = static_cast<std::uint8_t>(e.second);
     const auto kept = SeedKindDistances(graph, hard, 3, 10.0, 0.01, NoProgress(), &cache);
     ASSERT_EQ(kept.size(), 3u);
+    // The kinds on two threads: the same distances.
+    EXPECT_EQ(SeedKindDistances(graph, hard, 3, 10.0, 0.01, NoProgress(), &threaded, TwoThreads), kept);
     for (int k = 0; k < 3; ++k)
     {
       const std::vector<double> fresh = GeodesicDistances(graph, hard, static_cast<std::uint8_t>(k + 1), 10.0, 0.01);

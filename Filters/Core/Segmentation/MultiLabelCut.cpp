@@ -163,8 +163,8 @@ std::vector<double> PottsWeights(const GraphEdges& edges, const std::vector<doub
 // weighted by lambda * size; `cache` keeps each label's distances and updates them for its seed edits.
 bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, const ChannelBins& bins,
   const std::vector<double>* step, const std::vector<std::int16_t>& hard, int L, const SeedGeodesicParameters& geo,
-  double lambda, const std::vector<double>& size, std::vector<double>& cost, const ProgressFunction& progress,
-  MultiLabelCache* cache)
+  double lambda, const std::vector<double>& size, std::vector<double>& cost, const ParallelFor& parallel,
+  const ProgressFunction& progress, MultiLabelCache* cache)
 {
   const std::int64_t n = static_cast<std::int64_t>(hard.size());
   const int channels = bins.Channels;
@@ -187,8 +187,8 @@ bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, 
   {
     kind[p] = static_cast<std::uint8_t>(hard[p] + 1);
   }
-  const std::vector<std::vector<double>> distance =
-    SeedKindDistances(graph, kind, L, 1.0, geo.LengthWeight, progress, cache ? &cache->Geodesic : nullptr);
+  std::vector<std::vector<double>> distance =
+    SeedKindDistances(graph, kind, L, 1.0, geo.LengthWeight, progress, cache ? &cache->Geodesic : nullptr, parallel);
   if (distance.empty())
   {
     return false;
@@ -208,41 +208,43 @@ bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, 
   std::vector<double> own(kept ? 0 : n * L);
   std::vector<double>& term = kept ? kept->Term : own;
   const double mix = 0.01;
-  for (std::int64_t p = 0; p < n; ++p)
-  {
-    bool same = reuse;
-    for (int l = 0; l < L && same; ++l)
+  parallel(n, 16384, [&](std::int64_t p0, std::int64_t p1) {
+    for (std::int64_t p = p0; p < p1; ++p)
     {
-      same = distance[l][p] == kept->Distance[l][p];
+      bool same = reuse;
+      for (int l = 0; l < L && same; ++l)
+      {
+        same = distance[l][p] == kept->Distance[l][p];
+      }
+      if (same)
+      {
+        continue;
+      }
+      double total = 0.0;
+      int zeros = 0;
+      for (int l = 0; l < L; ++l)
+      {
+        const double d = distance[l][p];
+        zeros += d == 0.0;
+        total += d > 0.0 && std::isfinite(d) ? 1.0 / d : 0.0;
+      }
+      const double s = lambda * (size.empty() ? 1.0 : size[p]);
+      for (int l = 0; l < L; ++l)
+      {
+        const double d = distance[l][p];
+        const double share = zeros ? (d == 0.0 ? 1.0 / zeros : 0.0)
+                                   : (total > 0.0 ? (std::isfinite(d) ? 1.0 / d / total : 0.0) : 1.0 / L);
+        term[p * L + l] = s * -geo.Weight * std::log(mix + (1.0 - L * mix) * share);
+      }
     }
-    if (same)
-    {
-      continue;
-    }
-    double total = 0.0;
-    int zeros = 0;
-    for (int l = 0; l < L; ++l)
-    {
-      const double d = distance[l][p];
-      zeros += d == 0.0;
-      total += d > 0.0 && std::isfinite(d) ? 1.0 / d : 0.0;
-    }
-    const double s = lambda * (size.empty() ? 1.0 : size[p]);
-    for (int l = 0; l < L; ++l)
-    {
-      const double d = distance[l][p];
-      const double share = zeros ? (d == 0.0 ? 1.0 / zeros : 0.0)
-                                 : (total > 0.0 ? (std::isfinite(d) ? 1.0 / d / total : 0.0) : 1.0 / L);
-      term[p * L + l] = s * -geo.Weight * std::log(mix + (1.0 - L * mix) * share);
-    }
-  }
+  });
   for (std::int64_t i = 0; i < n * L; ++i)
   {
     cost[i] += term[i];
   }
   if (kept)
   {
-    kept->Distance = distance;
+    kept->Distance = std::move(distance);
   }
   return true;
 }
@@ -291,14 +293,14 @@ std::string CheckInputs(const LabelledSeeds& seeds, bool sizesMatch, const char*
 void SolveLabels(PottsProblem& pr, std::vector<std::int16_t> hard, const std::vector<double>& mean, const ChannelBins& bins,
   const std::vector<double>* step, const std::vector<double>& contact, const std::vector<double>& size,
   const std::vector<std::uint8_t>& border, const SeededCutParameters& par, const MultiLabelParameters& multi,
-  std::vector<std::uint8_t> start, const ProgressFunction& progress, MultiLabelCache* cache, Clock::time_point t0,
-  MultiLabelResult& r)
+  std::vector<std::uint8_t> start, const ParallelFor& parallel, const ProgressFunction& progress, MultiLabelCache* cache,
+  Clock::time_point t0, MultiLabelResult& r)
 {
   const GraphEdges& edges = *pr.Edges;
   if (par.Task == Task::Object && par.Geodesic.Weight > 0.0)
   {
     const auto g0 = Clock::now();
-    if (!AddGeodesicCosts(edges, mean, bins, step, hard, pr.Labels, par.Geodesic, par.Lambda, size, pr.Cost,
+    if (!AddGeodesicCosts(edges, mean, bins, step, hard, pr.Labels, par.Geodesic, par.Lambda, size, pr.Cost, parallel,
           SubProgress(progress, 0.0, 0.2), cache))
     {
       r.Aborted = true;
@@ -830,7 +832,7 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
   }
   const bool weighted = cache && static_cast<std::int64_t>(cache->Weight.size()) == edges.Size();
   SolveLabels(pr, hard, mean, bins, &step, weighted ? std::vector<double>() : ContactInVoxelFaces(mesh, par.ScaleByContact),
-    count, border, par, multi, std::move(start), progress, cache, t0, r);
+    count, border, par, multi, std::move(start), parallel, progress, cache, t0, r);
   if (!r.Error.empty() || r.Aborted)
   {
     return r;
@@ -875,7 +877,7 @@ MultiLabelResult MultiLabelVoxelCut(const std::vector<double>& values, const Cha
       pr.Cost[v * L + l] = par.Lambda * costs[l][bins.Bin[v]];
     }
   }
-  SolveLabels(pr, hard, values, bins, nullptr, {}, {}, BorderVoxels(g), par, multi, {}, progress, nullptr, t0, r);
+  SolveLabels(pr, hard, values, bins, nullptr, {}, {}, BorderVoxels(g), par, multi, {}, SerialFor(), progress, nullptr, t0, r);
   return r;
 }
 } // namespace featuremesh

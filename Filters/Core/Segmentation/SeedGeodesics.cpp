@@ -335,20 +335,48 @@ std::shared_ptr<SeedGeodesicCache::Kept> SeedGeodesicCache::Take(const GeodesicG
 }
 
 std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
-  int kinds, double scale, double lengthWeight, const ProgressFunction& progress, SeedGeodesicCache* cache)
+  int kinds, double scale, double lengthWeight, const ProgressFunction& progress, SeedGeodesicCache* cache,
+  const ParallelFor& parallel)
 {
   scale = UsableScale(scale);
   std::shared_ptr<SeedGeodesicCache::Kept> kept = SeedGeodesicCache::Take(graph, scale, lengthWeight, kinds, cache);
+  std::vector<std::vector<std::int64_t>> seeds(kinds);
+  std::vector<int> update;
   for (int k = 0; k < kinds; ++k)
   {
-    const std::vector<std::int64_t> seeds = SeedNodes(hard, static_cast<std::uint8_t>(k + 1));
-    if ((kept->Seeds[k] != seeds || kept->Field[k].Distance.empty()) &&
-      !UpdateField(graph, *kept->Neighbours, kept->Seeds[k], seeds, scale, lengthWeight, kept->Field[k],
-        SubProgress(progress, static_cast<double>(k) / kinds, static_cast<double>(k + 1) / kinds)))
+    seeds[k] = SeedNodes(hard, static_cast<std::uint8_t>(k + 1));
+    if (kept->Seeds[k] != seeds[k] || kept->Field[k].Distance.empty())
+    {
+      update.push_back(k);
+    }
+  }
+  const auto run = [&](int k, const ProgressFunction& report) {
+    return UpdateField(graph, *kept->Neighbours, kept->Seeds[k], seeds[k], scale, lengthWeight, kept->Field[k], report);
+  };
+  const std::int64_t count = static_cast<std::int64_t>(update.size());
+  if (graph.Nodes <= ConcurrentNodes)
+  {
+    parallel(count, 1, [&](std::int64_t i0, std::int64_t i1) {
+      for (std::int64_t i = i0; i < i1; ++i)
+      {
+        run(update[i], NoProgress());
+      }
+    });
+    if (!progress(0.9))
     {
       return {};
     }
-    kept->Seeds[k] = seeds;
+  }
+  for (std::int64_t i = 0; i < count && graph.Nodes > ConcurrentNodes; ++i)
+  {
+    if (!run(update[i], SubProgress(progress, static_cast<double>(i) / count, static_cast<double>(i + 1) / count)))
+    {
+      return {};
+    }
+  }
+  for (int k = 0; k < kinds; ++k)
+  {
+    kept->Seeds[k] = std::move(seeds[k]);
   }
   std::vector<std::vector<double>> distance(kinds);
   for (int k = 0; k < kinds; ++k)

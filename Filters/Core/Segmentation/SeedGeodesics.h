@@ -60,7 +60,7 @@ public:
 
 private:
   friend std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph&, const std::vector<std::uint8_t>&, int,
-    double, double, const ProgressFunction&, SeedGeodesicCache*);
+    double, double, const ProgressFunction&, SeedGeodesicCache*, const ParallelFor&);
   friend bool SeedGeodesicCosts(const GeodesicGraph&, const std::vector<std::uint8_t>&, double, const SeedGeodesicParameters&,
     const ParallelFor&, std::vector<double>&, std::vector<double>&, const ProgressFunction&, SeedGeodesicCache*);
   std::shared_ptr<Kept> State;
@@ -82,10 +82,11 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
 // Distances of every node from the seeds of each kind 1..kinds (hard[p] == kind), kept in `cache`
 // (optional) as SeedGeodesicCosts keeps its two kinds: a kind whose seeds changed is updated (added
 // seeds run Dijkstra from themselves, nodes rooted at removed ones restart from their neighbours),
-// the others reused. Empty when progress asks to abort.
+// the others reused; the kinds share `parallel`'s threads as SeedGeodesicCosts's two do. Empty
+// when progress asks to abort.
 std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
   int kinds, double scale, double lengthWeight, const ProgressFunction& progress = NoProgress(),
-  SeedGeodesicCache* cache = nullptr);
+  SeedGeodesicCache* cache = nullptr, const ParallelFor& parallel = SerialFor());
 
 // Empty when usable, else a sentence.
 std::string ValidateParameters(const SeedGeodesicParameters& p);
