@@ -98,6 +98,53 @@ inline double Extended(double d, const GeodesicGraph& g, std::int64_t p, std::in
   return d + std::fabs(g.Value[q] - g.Value[p]) * inverseScale + lengthWeight * step;
 }
 
+// A radix heap (Ahuja, Mehlhorn, Orlin & Tarjan 1990) of 8-byte entries, a 32-bit key above a
+// 32-bit node: Dijkstra pops keys that never decrease, so an entry is filed by the highest bit in
+// which its key differs from the last key popped, and each entry moves down at most 32 times
+// instead of sifting through a binary heap's log n levels on every push and pop.
+class RadixHeap
+{
+public:
+  bool Empty() const { return this->Size == 0; }
+  void Push(std::uint64_t entry)
+  {
+    this->Bucket[this->Index(entry >> 32)].push_back(entry);
+    ++this->Size;
+  }
+  std::uint64_t Pop()
+  {
+    if (this->Bucket[0].empty())
+    {
+      int i = 1;
+      while (this->Bucket[i].empty())
+      {
+        ++i;
+      }
+      std::vector<std::uint64_t>& from = this->Bucket[i];
+      this->Last = static_cast<std::uint32_t>(*std::min_element(from.begin(), from.end()) >> 32);
+      for (const std::uint64_t e : from)
+      {
+        this->Bucket[this->Index(e >> 32)].push_back(e);
+      }
+      from.clear();
+    }
+    const std::uint64_t e = this->Bucket[0].back();
+    this->Bucket[0].pop_back();
+    --this->Size;
+    return e;
+  }
+
+private:
+  int Index(std::uint64_t key) const
+  {
+    const std::uint32_t x = static_cast<std::uint32_t>(key) ^ this->Last;
+    return x == 0 ? 0 : 32 - __builtin_clz(x);
+  }
+  std::array<std::vector<std::uint64_t>, 33> Bucket;
+  std::uint32_t Last = 0;
+  std::int64_t Size = 0;
+};
+
 // Distances from one kind of seeds, with the seed each node's shortest path starts from.
 struct DistanceField
 {
@@ -121,7 +168,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   }
   std::vector<double>& distance = field.Distance;
   // Heap entries of 8 bytes: the distance rounded up to a float (non-negative floats order as
-  // their bits) above the node. Equal keys may pop a node before its last improvement; it is then
+  // their bits, and a longer path never rounds to a smaller key) above the node. Equal keys may pop a node before its last improvement; it is then
   // pushed and expanded again, so the distances stay exact.
   auto key = [](double d, std::int64_t p) {
     float f = static_cast<float>(d);
@@ -133,26 +180,22 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
     std::memcpy(&bits, &f, sizeof bits);
     return (static_cast<std::uint64_t>(bits) << 32) | static_cast<std::uint64_t>(p);
   };
-  std::vector<std::uint64_t> heap;
-  const auto later = std::greater<std::uint64_t>();
+  RadixHeap heap;
   for (std::int64_t p : seeds)
   {
     distance[p] = 0.0;
     field.Root[p] = p;
-    heap.push_back(key(0.0, p));
+    heap.Push(key(0.0, p));
   }
   for (std::int64_t p : start)
   {
-    heap.push_back(key(distance[p], p));
+    heap.Push(key(distance[p], p));
   }
-  std::make_heap(heap.begin(), heap.end(), later);
   const double inverse = 1.0 / scale;
   std::int64_t popped = 0;
-  while (!heap.empty())
+  while (!heap.Empty())
   {
-    std::pop_heap(heap.begin(), heap.end(), later);
-    const std::uint64_t top = heap.back();
-    heap.pop_back();
+    const std::uint64_t top = heap.Pop();
     const std::int64_t p = static_cast<std::int64_t>(top & 0xffffffffu);
     const double d = distance[p];
     if ((top >> 32) != (key(d, p) >> 32))
@@ -170,8 +213,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
       {
         distance[q] = candidate;
         field.Root[q] = root;
-        heap.push_back(key(candidate, q));
-        std::push_heap(heap.begin(), heap.end(), later);
+        heap.Push(key(candidate, q));
       }
     });
   }

@@ -40,7 +40,7 @@ struct GeodesicGraph
 };
 
 // Geodesic distance of every node from the nodes with hard[p] == seedKind (infinity where none is
-// reachable), edge length |dValue| / scale + lengthWeight * step. Dijkstra on a binary heap of
+// reachable), edge length |dValue| / scale + lengthWeight * step. Dijkstra on a radix heap of
 // 8-byte entries (fewer than 2^32 nodes); for explicit edges a CSR adjacency is built first. Empty
 // when progress asks to abort.
 std::vector<double> GeodesicDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
