@@ -817,6 +817,64 @@ TEST(SeedGeodesics, KeptDistancesEqualFreshOnes)
   }
 }
 
+TEST(SeedGeodesics, DijkstraMatchesBellmanFord)
+{
+  // A random graph with random values, steps and seeds, and a plateau where many paths tie: the
+  // heap's distances equal those of Bellman-Ford relaxation (no heap at all).
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const std::int64_t n = 600;
+  std::vector<std::int64_t> a, b;
+  std::vector<double> step;
+  for (int e = 0; e < 2400; ++e)
+  {
+    const std::int64_t p = rng() % n, q = rng() % n;
+    if (p != q)
+    {
+      a.push_back(p);
+      b.push_back(q);
+      step.push_back(e % 3 ? 1.0 : 0.5 + 2.0 * u(rng));
+    }
+  }
+  std::vector<double> value(n);
+  for (std::int64_t p = 0; p < n; ++p)
+    value[p] = p < 200 ? 3.0 : 10.0 * u(rng);
+  const GraphEdges edges(a, b);
+  GeodesicGraph graph;
+  graph.Edges = &edges;
+  graph.Value = value.data();
+  graph.Nodes = n;
+  graph.Step = &step;
+  std::vector<std::uint8_t> hard(n, 0);
+  for (int s = 0; s < 6; ++s)
+    hard[rng() % n] = 1;
+  const std::vector<double> d = GeodesicDistances(graph, hard, 1, 7.0, 0.01);
+  std::vector<double> r(n, std::numeric_limits<double>::infinity());
+  for (std::int64_t p = 0; p < n; ++p)
+    if (hard[p] == 1)
+      r[p] = 0.0;
+  for (bool changed = true; changed;)
+  {
+    changed = false;
+    for (std::size_t e = 0; e < a.size(); ++e)
+      for (const auto& [p, q] : { std::make_pair(a[e], b[e]), std::make_pair(b[e], a[e]) })
+      {
+        const double c = r[p] + std::fabs(value[q] - value[p]) / 7.0 + 0.01 * step[e];
+        if (c < r[q])
+        {
+          r[q] = c;
+          changed = true;
+        }
+      }
+  }
+  ASSERT_EQ(d.size(), static_cast<std::size_t>(n));
+  for (std::int64_t p = 0; p < n; ++p)
+    if (std::isinf(r[p]))
+      EXPECT_TRUE(std::isinf(d[p])) << "node " << p;
+    else
+      EXPECT_NEAR(d[p], r[p], 1e-12 * (1.0 + r[p])) << "node " << p;
+}
+
 TEST(SeedGeodesics, DistancesAddTheStepsAndTheLength)
 {
   // A chain 0 - 1 - 2 - 3 of values 0, 0, 10, 10 (range 10): each step costs |dI| / 10 plus the
