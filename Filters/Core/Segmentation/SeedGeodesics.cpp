@@ -168,8 +168,9 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   }
   std::vector<double>& distance = field.Distance;
   // Heap entries of 8 bytes: the distance rounded up to a float (non-negative floats order as
-  // their bits, and a longer path never rounds to a smaller key) above the node. Equal keys may pop a node before its last improvement; it is then
-  // pushed and expanded again, so the distances stay exact.
+  // their bits, and a longer path never rounds to a smaller key) above the node. Equal keys may
+  // pop a node before its last improvement; it is then pushed and expanded again, so the
+  // distances stay exact.
   auto key = [](double d, std::int64_t p) {
     float f = static_cast<float>(d);
     if (static_cast<double>(f) < d)
