@@ -193,6 +193,8 @@ int vtkSuperVoxelCut::RequestData(
       voxelValue = [binaryValues](std::int64_t v) { return binaryValues->GetComponent(v, 0); };
     }
     MeshData& data = *this->Prepared;
+    // A binary cut does not use the labelled seeds' move graphs (hundreds of MB on a brain volume).
+    data.Multi.Moves.Clear();
     const SuperVoxelCutResult result = featuremesh::SuperVoxelCut(data.Mesh, data.Cut, data.Mean, data.Count,
       objectVoxels, backgroundVoxels, voxelValue, *this, SMPParallelFor(), AlgorithmProgress(this, 0.45, 0.95), &data.Flow);
     if (result.Aborted || !result.Error.empty())
