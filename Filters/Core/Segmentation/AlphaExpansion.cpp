@@ -1,4 +1,5 @@
 #include "AlphaExpansion.h"
+#include "Memory.h"
 
 #include <maxflow.h>
 
@@ -475,11 +476,16 @@ double RecycledMove(const PottsProblem& pr, int alpha, const std::vector<std::ui
     {
       lg.G.reset(new Flow(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory));
       lg.Changed.reset(new maxflow::Block<int>(4096));
+      // The arcs, most of a graph's memory, are first touched below.
+      AdviseHugePages(lg.G->get_first_arc(), static_cast<std::size_t>(2 * m) * sizeof(*lg.G->get_first_arc()));
     }
     Flow& g = *lg.G;
     g.reset();
     g.add_node(static_cast<int>(n));
-    lg.Cap.resize(2 * m);
+    if (lg.Cap.size() != static_cast<std::size_t>(2 * m))
+    {
+      AssignFresh(lg.Cap, static_cast<std::size_t>(2 * m));
+    }
     lg.Net.resize(n);
     pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
       capacities(p, q, pr.Weight[k], lg.Cap[2 * k], lg.Cap[2 * k + 1]);
