@@ -360,15 +360,7 @@ RecycledMoves::State* SyncRecycled(RecycledMoves& recycled, const PottsProblem& 
     k.reset(new RecycledMoves::State);
     k->Nodes = n;
     k->Labels = L;
-    if (pr.Edges->IsGrid() || pr.Edges->Held())
-    {
-      k->Edges = *pr.Edges;
-    }
-    else
-    {
-      k->Edges = GraphEdges::Owned(std::vector<std::int64_t>(pr.Edges->First(), pr.Edges->First() + m),
-        std::vector<std::int64_t>(pr.Edges->Second(), pr.Edges->Second() + m));
-    }
+    k->Edges = pr.Edges->Keepable();
     k->Weight = pr.Weight;
     k->Cost = pr.Cost;
     k->Hard = pr.Hard.empty() ? std::vector<std::int16_t>(n, -1) : pr.Hard;

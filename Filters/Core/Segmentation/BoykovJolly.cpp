@@ -998,12 +998,8 @@ bool MaxFlow(const std::shared_ptr<Flow>& g, std::int64_t n, bool reuse, const P
 std::shared_ptr<MaxFlowCache::Kept> NewKept(
   const CutProblem& pr, double sigmaParameter, double sigma, double weightTotal, std::unique_ptr<double[]> weight)
 {
-  const GraphEdges& edges = pr.Edges;
-  const std::int64_t m = edges.Size();
   auto kept = std::make_shared<MaxFlowCache::Kept>();
-  kept->Edges = edges.IsGrid() || edges.Held() ? edges
-                                               : GraphEdges::Owned(std::vector<std::int64_t>(edges.First(), edges.First() + m),
-                                                   std::vector<std::int64_t>(edges.Second(), edges.Second() + m));
+  kept->Edges = pr.Edges.Keepable();
   kept->Value = pr.Value;
   kept->Contact = pr.Contact;
   kept->SigmaParameter = sigmaParameter;

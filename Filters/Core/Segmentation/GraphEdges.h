@@ -66,6 +66,16 @@ public:
 
   // Lists that a holder keeps unchanged (owned, or held): safe to keep instead of copying.
   bool Held() const { return this->Keep != nullptr; }
+  // The same edges for a record that outlives the lists it views: grids and held lists as they are,
+  // viewed lists copied.
+  GraphEdges Keepable() const
+  {
+    if (this->IsGrid() || this->Held())
+    {
+      return *this;
+    }
+    return Owned(std::vector<std::int64_t>(this->A, this->A + this->M), std::vector<std::int64_t>(this->B, this->B + this->M));
+  }
   // The same edges in the same order.
   bool Same(const GraphEdges& o) const
   {

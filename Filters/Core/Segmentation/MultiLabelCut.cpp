@@ -317,11 +317,11 @@ void SolveLabels(PottsProblem& pr, std::vector<std::int16_t> hard, const std::ve
   else
   {
     pr.Weight = PottsWeights(edges, mean, bins.Channels, contact, r.Sigma);
-  }
-  if (cache)
-  {
-    cache->Weight = pr.Weight;
-    cache->Sigma = r.Sigma;
+    if (cache)
+    {
+      cache->Weight = pr.Weight;
+      cache->Sigma = r.Sigma;
+    }
   }
   pr.Hard = hard;
   r.SetupSeconds = Since(t0);

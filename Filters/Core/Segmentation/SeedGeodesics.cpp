@@ -350,12 +350,7 @@ std::shared_ptr<SeedGeodesicCache::Kept> SeedGeodesicCache::Take(const GeodesicG
     kept->Neighbours.reset(new Adjacency(*graph.Edges, graph.Nodes, graph.Step));
     if (cache)
     {
-      const GraphEdges& edges = *graph.Edges;
-      // Held lists are kept as they are; lists only viewed are copied.
-      kept->Edges = edges.IsGrid() || edges.Held()
-        ? edges
-        : GraphEdges::Owned(std::vector<std::int64_t>(edges.First(), edges.First() + edges.Size()),
-            std::vector<std::int64_t>(edges.Second(), edges.Second() + edges.Size()));
+      kept->Edges = graph.Edges->Keepable();
       kept->Value.assign(graph.Value, graph.Value + graph.Nodes);
       if (graph.Step)
       {
@@ -377,24 +372,25 @@ std::shared_ptr<SeedGeodesicCache::Kept> SeedGeodesicCache::Take(const GeodesicG
   return kept;
 }
 
-std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
-  int kinds, double scale, double lengthWeight, const ProgressFunction& progress, SeedGeodesicCache* cache,
-  const ParallelFor& parallel)
+namespace
 {
-  scale = UsableScale(scale);
-  std::shared_ptr<SeedGeodesicCache::Kept> kept = SeedGeodesicCache::Take(graph, scale, lengthWeight, kinds, cache);
-  std::vector<std::vector<std::int64_t>> seeds(kinds);
+// The kept distances of kinds 1..seeds.size() made exact for these seed nodes: kinds whose seeds
+// changed are updated side by side on `parallel`'s threads up to ConcurrentNodes nodes (progress
+// then reported after them only), one after the other beyond, over [0, 0.9] of progress. False
+// when progress asks to abort.
+bool UpdateKinds(const GeodesicGraph& graph, std::vector<std::vector<std::int64_t>> seeds, double scale,
+  double lengthWeight, const ParallelFor& parallel, const ProgressFunction& progress, SeedGeodesicCache::Kept& kept)
+{
   std::vector<int> update;
-  for (int k = 0; k < kinds; ++k)
+  for (int k = 0; k < static_cast<int>(seeds.size()); ++k)
   {
-    seeds[k] = SeedNodes(hard, static_cast<std::uint8_t>(k + 1));
-    if (kept->Seeds[k] != seeds[k] || kept->Field[k].Distance.empty())
+    if (kept.Seeds[k] != seeds[k] || kept.Field[k].Distance.empty())
     {
       update.push_back(k);
     }
   }
   const auto run = [&](int k, const ProgressFunction& report) {
-    return UpdateField(graph, *kept->Neighbours, kept->Seeds[k], seeds[k], scale, lengthWeight, kept->Field[k], report);
+    return UpdateField(graph, *kept.Neighbours, kept.Seeds[k], seeds[k], scale, lengthWeight, kept.Field[k], report);
   };
   const std::int64_t count = static_cast<std::int64_t>(update.size());
   if (graph.Nodes <= ConcurrentNodes)
@@ -407,19 +403,38 @@ std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph& graph, c
     });
     if (!progress(0.9))
     {
-      return {};
+      return false;
     }
   }
   for (std::int64_t i = 0; i < count && graph.Nodes > ConcurrentNodes; ++i)
   {
-    if (!run(update[i], SubProgress(progress, static_cast<double>(i) / count, static_cast<double>(i + 1) / count)))
+    if (!run(update[i], SubProgress(progress, 0.9 * i / count, 0.9 * (i + 1) / count)))
     {
-      return {};
+      return false;
     }
   }
+  for (std::size_t k = 0; k < seeds.size(); ++k)
+  {
+    kept.Seeds[k] = std::move(seeds[k]);
+  }
+  return true;
+}
+} // namespace
+
+std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
+  int kinds, double scale, double lengthWeight, const ProgressFunction& progress, SeedGeodesicCache* cache,
+  const ParallelFor& parallel)
+{
+  scale = UsableScale(scale);
+  std::shared_ptr<SeedGeodesicCache::Kept> kept = SeedGeodesicCache::Take(graph, scale, lengthWeight, kinds, cache);
+  std::vector<std::vector<std::int64_t>> seeds(kinds);
   for (int k = 0; k < kinds; ++k)
   {
-    kept->Seeds[k] = std::move(seeds[k]);
+    seeds[k] = SeedNodes(hard, static_cast<std::uint8_t>(k + 1));
+  }
+  if (!UpdateKinds(graph, std::move(seeds), scale, lengthWeight, parallel, progress, *kept))
+  {
+    return {};
   }
   std::vector<std::vector<double>> distance(kinds);
   for (int k = 0; k < kinds; ++k)
@@ -439,45 +454,17 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
 {
   costObject.clear();
   costBackground.clear();
-  const std::array<std::vector<std::int64_t>, 2> seeds{ { SeedNodes(hard, 1), SeedNodes(hard, 2) } };
+  std::vector<std::vector<std::int64_t>> seeds{ SeedNodes(hard, 1), SeedNodes(hard, 2) };
   if (par.Weight <= 0.0 || seeds[0].empty() || seeds[1].empty() || graph.Nodes == 0)
   {
     return true;
   }
   scale = UsableScale(scale);
   std::shared_ptr<SeedGeodesicCache::Kept> kept = SeedGeodesicCache::Take(graph, scale, par.LengthWeight, 2, cache);
-  // Per kind: the kept distances updated for the seeds added and removed, or afresh.
-  std::array<bool, 2> update{ { kept->Seeds[0] != seeds[0] || kept->Field[0].Distance.empty(),
-    kept->Seeds[1] != seeds[1] || kept->Field[1].Distance.empty() } };
-  bool done = true;
-  if (graph.Nodes <= ConcurrentNodes)
-  {
-    parallel(2, 1, [&](std::int64_t k0, std::int64_t k1) {
-      for (std::int64_t k = k0; k < k1; ++k)
-      {
-        if (update[k])
-        {
-          UpdateField(graph, *kept->Neighbours, kept->Seeds[k], seeds[k], scale, par.LengthWeight, kept->Field[k], NoProgress());
-        }
-      }
-    });
-    done = progress(0.9);
-  }
-  else
-  {
-    for (int k = 0; k < 2 && done; ++k)
-    {
-      done = !update[k] ||
-        UpdateField(graph, *kept->Neighbours, kept->Seeds[k], seeds[k], scale, par.LengthWeight, kept->Field[k],
-          SubProgress(progress, 0.45 * k, 0.45 * (k + 1)));
-    }
-  }
-  if (!done)
+  if (!UpdateKinds(graph, std::move(seeds), scale, par.LengthWeight, parallel, progress, *kept))
   {
     return false;
   }
-  kept->Seeds[0] = seeds[0];
-  kept->Seeds[1] = seeds[1];
   const std::vector<double>& toObject = kept->Field[0].Distance;
   const std::vector<double>& toBackground = kept->Field[1].Distance;
   constexpr double mix = 0.01;
