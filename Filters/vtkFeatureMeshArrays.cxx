@@ -2,6 +2,7 @@
 #include "vtkFeatureMeshFrame.h"
 
 #include "Contract.h"
+#include "ImageFilters.h"
 #include "MultiLabelCut.h"
 
 #include "vtkCellData.h"
@@ -131,6 +132,62 @@ const float* FloatValues(vtkDataArray* array, std::vector<float>& storage, std::
   }
   // Conversion, or the NaN/Inf error message.
   return ToFloat(array, storage, error) ? storage.data() : nullptr;
+}
+
+LocalContrastArray::LocalContrastArray() = default;
+LocalContrastArray::~LocalContrastArray() = default;
+
+vtkDataArray* LocalContrastArray::Of(
+  vtkDataArray* values, const ImageGeometry& g, double scale, const ParallelFor& parallel, std::string& error)
+{
+  if (this->Result && this->Source == values && this->Time == values->GetMTime() && this->Scale == scale &&
+    SameFrame(this->Frame, g))
+  {
+    return this->Result;
+  }
+  this->Result = nullptr;
+  const int components = values->GetNumberOfComponents();
+  const vtkIdType n = values->GetNumberOfTuples();
+  vtkNew<vtkFloatArray> result;
+  result->SetName(values->GetName());
+  result->SetNumberOfComponents(components);
+  result->SetNumberOfTuples(n);
+  std::vector<float> channel(n), contrast(n);
+  vtkIdType bad = 0;
+  for (int c = 0; c < components; ++c)
+  {
+    switch (values->GetDataType())
+    {
+      vtkTemplateMacro(const VTK_TT* v = static_cast<const VTK_TT*>(values->GetVoidPointer(0));
+                       for (vtkIdType i = 0; i < n; ++i) {
+                         const double x = static_cast<double>(v[i * components + c]);
+                         const bool ok = std::isfinite(x) && std::fabs(x) <= 3.4e38;
+                         bad += ok ? 0 : 1;
+                         channel[i] = ok ? static_cast<float>(x) : 0.0f;
+                       });
+      default:
+        error = "the array's value type is not supported.";
+        return nullptr;
+    }
+    if (bad)
+    {
+      error = std::string("the array '") + (values->GetName() ? values->GetName() : "") + "' holds " +
+        std::to_string(bad) + " values that are NaN, infinite or beyond +-3.4e38; replace or rescale them first.";
+      return nullptr;
+    }
+    LocalContrast(channel.data(), contrast.data(), g, scale, parallel);
+    float* out = result->GetPointer(0);
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      out[i * components + c] = contrast[i];
+    }
+  }
+  this->Source = values;
+  this->Time = values->GetMTime();
+  this->Scale = scale;
+  this->Frame = g;
+  this->Result = result;
+  return this->Result;
 }
 
 bool ToDouble(vtkDataArray* array, std::vector<double>& values, std::string& error)

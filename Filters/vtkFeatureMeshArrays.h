@@ -4,6 +4,7 @@
 #define vtkFeatureMeshArrays_h
 
 #include "ImageGeometry.h"
+#include "Parallel.h"
 
 #include "vtkSmartPointer.h"
 
@@ -15,6 +16,7 @@
 
 class vtkDataObject;
 class vtkDataArray;
+class vtkFloatArray;
 class vtkImageData;
 class vtkInformation;
 
@@ -34,6 +36,26 @@ bool ToFloat(vtkDataArray* array, std::vector<float>& values, std::string& error
 // (no copy: copying BraTS costs ~50 ms, most of it page faults), else converted into `storage`.
 // Null with `error` set when the array is unusable (components, type, NaN/Inf).
 const float* FloatValues(vtkDataArray* array, std::vector<float>& storage, std::string& error);
+
+// The local contrast (LocalContrast, ImageFilters.h) of each component of an image array, as a float
+// array of as many components, kept while the array (the same object, unmodified), the frame and the
+// scale stay the same: a seed edit reuses it.
+class LocalContrastArray
+{
+public:
+  LocalContrastArray();
+  ~LocalContrastArray();
+  // Null with `error` set when a value is NaN, infinite or beyond +-3.4e38, or the type is not supported.
+  vtkDataArray* Of(vtkDataArray* values, const ImageGeometry& geometry, double scale, const ParallelFor& parallel,
+    std::string& error);
+
+private:
+  vtkDataArray* Source = nullptr;
+  unsigned long Time = 0;
+  double Scale = 0.0;
+  ImageGeometry Frame;
+  vtkSmartPointer<vtkFloatArray> Result;
+};
 
 // The image as the filters read it: values on voxel centres (point data). An image whose values
 // are cell data (each cell a voxel, as ParaView's GDAL reader gives a PNG or TIFF) becomes the image

@@ -53,6 +53,8 @@ void SetClampedParameter(vtkObject* filter, Parameter& parameter, int value, int
     featuremesh::SetClampedParameter(this, this->featuremesh::SeededCutParameters::Connectivity, value, 0, 3);    \
   }                                                                                                                \
   int cls::GetConnectivity() { return static_cast<int>(this->featuremesh::SeededCutParameters::Connectivity); }    \
+  void cls::SetIntensity(int value) { featuremesh::SetParameter(this, this->featuremesh::SeededCutParameters::Intensity, value); } \
+  int cls::GetIntensity() { return static_cast<int>(this->featuremesh::SeededCutParameters::Intensity); }          \
   void cls::SetGeodesicWeight(double value) { featuremesh::SetParameter(this, this->Geodesic.Weight, value); }     \
   double cls::GetGeodesicWeight() { return this->Geodesic.Weight; }                                                \
   void cls::SetGeodesicLength(double value) { featuremesh::SetParameter(this, this->Geodesic.LengthWeight, value); } \

@@ -153,6 +153,27 @@ int vtkSuperVoxelCut::RequestData(
     {
       return 0;
     }
+    const bool contrast = UsesLocalContrast(*this);
+    if (contrast && !valuesArray && this->featuremesh::SeededCutParameters::Intensity == CutIntensity::LocalContrast)
+    {
+      return this->Fail("the local contrast is read from the image: connect the Image input.");
+    }
+    if (contrast && !valuesArray)
+    {
+      this->Warn("Task Class reads the image's local contrast; without the Image input the cut reads the elements' MeanIntensity.");
+    }
+    if (contrast && valuesArray)
+    {
+      if (!this->Contrast)
+      {
+        this->Contrast = std::make_unique<LocalContrastArray>();
+      }
+      valuesArray = this->Contrast->Of(valuesArray, geometry, this->ContrastScale, SMPParallelFor(), error);
+      if (!valuesArray)
+      {
+        return this->Fail(error);
+      }
+    }
     if (!labelledSeeds && (!objectSeeds || !backgroundSeeds))
     {
       return this->Fail("connect the Object Seeds and the Background Seeds, or labelled Seeds.");
@@ -164,7 +185,7 @@ int vtkSuperVoxelCut::RequestData(
       return this->Fail("the image array has " + std::to_string(valuesArray->GetNumberOfComponents()) +
         " components; a binary cut takes one (choose a one-component array), labelled Seeds take several.");
     }
-    if (const int done = this->Prepare(input, geometry, valuesArray, binaryValues); done >= 0)
+    if (const int done = this->Prepare(input, geometry, valuesArray, binaryValues, contrast && binaryValues); done >= 0)
     {
       return done;
     }
@@ -229,7 +250,7 @@ void vtkSuperVoxelCut::WriteCutFields(
 }
 
 int vtkSuperVoxelCut::Prepare(vtkUnstructuredGrid* input, const featuremesh::ImageGeometry& geometry,
-  vtkDataArray* valuesArray, vtkDataArray* binaryValues)
+  vtkDataArray* valuesArray, vtkDataArray* binaryValues, bool voxelMeans)
 {
   using namespace featuremesh;
   vtkDataArray* meanArray = input->GetCellData()->GetArray(names::MeanIntensity);
@@ -298,6 +319,10 @@ int vtkSuperVoxelCut::Prepare(vtkUnstructuredGrid* input, const featuremesh::Ima
   {
     return error.empty() ? 1 : this->Fail(error); // aborted, or a bad value
   }
+  if (voxelMeans)
+  {
+    prepared->Mean = NodeMeans(prepared->Cut.Voxels);
+  }
   this->Prepared = std::move(prepared);
   return -1;
 }
@@ -361,7 +386,7 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
   switch (values->GetDataType())
   {
     vtkTemplateMacro(perChannel = SeedBinsPerChannel(static_cast<const VTK_TT*>(values->GetVoidPointer(0)), channels,
-                       geometry, par.SampleSeedElements ? &mesh : nullptr, data.Cut.Owner.data(), seeds,
+                       geometry, SamplesSeedElements(par) ? &mesh : nullptr, data.Cut.Owner.data(), seeds,
                        par.SeedRadius, par.Bins, par.Bandwidth, &data.Bins));
   }
   if (data.Bins.Channels != channels || data.Bins.PerChannel != perChannel)
@@ -419,6 +444,8 @@ void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
      << indent << "Lambda: " << this->Lambda << "\n"
      << indent << "Task: " << this->GetTask() << "\n"
      << indent << "Connectivity: " << this->GetConnectivity() << "\n"
+     << indent << "Intensity: " << this->GetIntensity() << "\n"
+     << indent << "ContrastScale: " << this->ContrastScale << "\n"
      << indent << "GeodesicWeight: " << this->GetGeodesicWeight() << "\n"
      << indent << "GeodesicLength: " << this->GetGeodesicLength() << "\n"
      << indent << "Bandwidth: " << this->Bandwidth << "\n"

@@ -30,6 +30,10 @@
 #include <vector>
 
 class vtkDataArray;
+namespace featuremesh
+{
+class LocalContrastArray;
+}
 class vtkUnstructuredGrid;
 // The filter is its Core parameters (TTK's shape): each energy property's value and default live in
 // featuremesh::SuperVoxelCutParameters and MultiLabelParameters, which the setters write.
@@ -63,6 +67,13 @@ public:
   /// 3 from the task (default: 2 for Object, 1 for Class).
   virtual void SetConnectivity(int value);
   virtual int GetConnectivity();
+  /// What the cut reads at each voxel (featuremesh::CutIntensity): 0 the image's values, 1 their
+  /// local contrast, 2 from the task (default: 1 for Class, 0 for Object). Out of range: an error at execution.
+  virtual void SetIntensity(int value);
+  virtual int GetIntensity();
+  /// Gaussian scale (voxels) of the local contrast's neighbourhood (default 8).
+  vtkSetMacro(ContrastScale, double);
+  vtkGetMacro(ContrastScale, double);
   /// Weight of the seeds' geodesic spatial term for Task Object (featuremesh::SeedGeodesicParameters); 0 = off.
   virtual void SetGeodesicWeight(double value);
   virtual double GetGeodesicWeight();
@@ -125,8 +136,10 @@ private:
   void WriteLabels(vtkUnstructuredGrid* input, const std::vector<std::uint8_t>& labels,
     const std::vector<std::int64_t>& boundaryFaces, vtkInformationVector* outputVector);
   // Makes (or keeps, for a seed edit) the mesh-dependent data: -1 to go on, else RequestData's result.
+  // With `voxelMeans` the elements' intensities are the means of `binaryValues` over their voxels
+  // (the local contrast), not the mesh's MeanIntensity.
   int Prepare(vtkUnstructuredGrid* input, const featuremesh::ImageGeometry& geometry, vtkDataArray* valuesArray,
-    vtkDataArray* binaryValues);
+    vtkDataArray* binaryValues, bool voxelMeans);
   // The binary cut's field data on the labelled mesh and the label image.
   void WriteCutFields(const featuremesh::SuperVoxelCutResult& result, double voxelVolume, vtkInformationVector* outputVector);
   // The cut with labelled seeds on the Seeds input.
@@ -137,6 +150,8 @@ private:
   // re-runs only the cut.
   struct MeshData;
   std::unique_ptr<MeshData> Prepared;
+  // The image's local contrast, when the cut reads it, kept for the next cut of the same image.
+  std::unique_ptr<featuremesh::LocalContrastArray> Contrast;
   vtkSuperVoxelCut(const vtkSuperVoxelCut&) = delete;
   void operator=(const vtkSuperVoxelCut&) = delete;
 };

@@ -29,6 +29,8 @@ vtkVoxelCut::vtkVoxelCut()
   this->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
 }
 
+vtkVoxelCut::~vtkVoxelCut() = default;
+
 FEATUREMESH_SEEDED_CUT_ACCESSORS(vtkVoxelCut)
 
 int vtkVoxelCut::FillInputPortInformation(int port, vtkInformation* info)
@@ -81,6 +83,18 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     }
     const VoxelCutParameters& par = *this;
     std::string error;
+    if (UsesLocalContrast(par))
+    {
+      if (!this->Contrast)
+      {
+        this->Contrast = std::make_unique<LocalContrastArray>();
+      }
+      array = this->Contrast->Of(array, geometry, this->ContrastScale, SMPParallelFor(), error);
+      if (!array)
+      {
+        return this->Fail(error);
+      }
+    }
     std::vector<std::int64_t> objectVoxels, backgroundVoxels;
     if (labelledSeeds)
     {
@@ -179,6 +193,8 @@ void vtkVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
      << indent << "Lambda: " << this->Lambda << "\n"
      << indent << "Task: " << this->GetTask() << "\n"
      << indent << "Connectivity: " << this->GetConnectivity() << "\n"
+     << indent << "Intensity: " << this->GetIntensity() << "\n"
+     << indent << "ContrastScale: " << this->ContrastScale << "\n"
      << indent << "GeodesicWeight: " << this->GetGeodesicWeight() << "\n"
      << indent << "GeodesicLength: " << this->GetGeodesicLength() << "\n"
      << indent << "Bandwidth: " << this->Bandwidth << "\n"

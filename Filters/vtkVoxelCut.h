@@ -19,9 +19,14 @@
 #include "SuperVoxelCut.h"
 #include "vtkImageAlgorithm.h"
 
+#include <memory>
 #include <string>
 
 class vtkDataArray;
+namespace featuremesh
+{
+class LocalContrastArray;
+}
 
 // The filter is its Core parameters (TTK's shape): each energy property's value and default live in
 // featuremesh::VoxelCutParameters and MultiLabelParameters, which the setters write.
@@ -55,6 +60,13 @@ public:
   /// 3 from the task (default: 2 for Object, 1 for Class).
   virtual void SetConnectivity(int value);
   virtual int GetConnectivity();
+  /// What the cut reads at each voxel (featuremesh::CutIntensity): 0 the image's values, 1 their
+  /// local contrast, 2 from the task (default: 1 for Class, 0 for Object). Out of range: an error at execution.
+  virtual void SetIntensity(int value);
+  virtual int GetIntensity();
+  /// Gaussian scale (voxels) of the local contrast's neighbourhood (default 8).
+  vtkSetMacro(ContrastScale, double);
+  vtkGetMacro(ContrastScale, double);
   /// Weight of the seeds' geodesic spatial term for Task Object (featuremesh::SeedGeodesicParameters); 0 = off.
   virtual void SetGeodesicWeight(double value);
   virtual double GetGeodesicWeight();
@@ -81,7 +93,7 @@ public:
 
 protected:
   vtkVoxelCut();
-  ~vtkVoxelCut() override = default;
+  ~vtkVoxelCut() override;
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
@@ -92,6 +104,8 @@ protected:
   std::string LabelNames;
 
 private:
+  // The image's local contrast, when the cut reads it, kept for the next cut of the same image.
+  std::unique_ptr<featuremesh::LocalContrastArray> Contrast;
   int RequestMultiLabel(const featuremesh::LabelledSeeds& seeds, vtkDataArray* array,
     const featuremesh::ImageGeometry& geometry, const featuremesh::VoxelCutParameters& parameters,
     vtkInformationVector* outputVector);

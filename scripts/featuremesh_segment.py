@@ -4,7 +4,7 @@
 usage: pvpython featuremesh_segment.py IMAGE (--object-seeds CSV --background-seeds CSV | --seeds CSV [--labels CSV])
                                        [--truth LABELS] [--out DIR] [--plugin FeatureMesh.so]
                                        [--task object|class] [--lambda L] [--connectivity task|off|fill|seeded]
-                                       [--sigma S] [--bins B]
+                                       [--intensity task|image|contrast] [--contrast-scale S] [--sigma S] [--bins B]
                                        [--no-smoothing] [--rsp] [--surface-method laplacian|taubin]
                                        [--surface-iterations N] [--unit mm]
 --rsp runs RSP Edge Enhancement first and feeds its edge map to Feature Nodes (seed-aware nodes: fine
@@ -37,6 +37,7 @@ from featuremesh import fem, metrics
 
 CONNECTIVITY = {"task": "From Task", "off": "Off", "fill": "Fill Holes", "seeded": "Seeded Object"}
 TASK = {"object": "Object", "class": "Class"}
+INTENSITY = {"task": "From Task", "image": "Image", "contrast": "Local Contrast"}
 SURFACE_METHOD = {"laplacian": 0, "taubin": 1}
 
 
@@ -62,6 +63,11 @@ def main():
     cut_options.add_argument("--connectivity", choices=sorted(CONNECTIVITY),
                              help="off: the cut as it is; fill: fill background holes (several objects of a kind "
                                   "stay); seeded: one object, what the object seeds reach")
+    cut_options.add_argument("--intensity", choices=sorted(INTENSITY),
+                             help="what the cut reads: image: the image's values; contrast: their local contrast "
+                                  "(shading drops out); task: contrast for --task class, image for object")
+    cut_options.add_argument("--contrast-scale", type=float,
+                             help="Gaussian scale (voxels) of the local contrast's neighbourhood (property ContrastScale)")
     cut_options.add_argument("--sigma", type=float, help="boundary-term sigma, 0 = automatic")
     cut_options.add_argument("--bins", type=int, help="seed histogram bins, 0 = automatic")
     ap.add_argument("--no-smoothing", action="store_true", help="cut the Delaunay mesh (skip Image Mesh Smoothing)")
@@ -109,7 +115,8 @@ def main():
     delaunay = DelaunayImageMesh(Nodes=nodes, Image=first, Scalars=scalars)
     mesh = delaunay if args.no_smoothing else ImageMeshSmoothing(Mesh=delaunay, Image=first, Scalars=scalars)
     options = {name: value for name, value in (("Lambda", args.lam), ("Sigma", args.sigma), ("Bins", args.bins),
-               ("Connectivity", CONNECTIVITY.get(args.connectivity)), ("Task", TASK.get(args.task)))
+               ("Connectivity", CONNECTIVITY.get(args.connectivity)), ("Task", TASK.get(args.task)),
+               ("Intensity", INTENSITY.get(args.intensity)), ("ContrastScale", args.contrast_scale))
                if value is not None}
     if args.seeds:
         if names:
@@ -163,6 +170,7 @@ def main():
               "object_elements": int((v2n(labelled.GetCellData().GetArray(fm.names.Label)) > 0).sum()),
               "task": cut.GetProperty("Task").GetData(), "lambda": float(cut.Lambda),
               "connectivity": cut.GetProperty("Connectivity").GetData(),
+              "intensity": cut.GetProperty("Intensity").GetData(), "contrast_scale": float(cut.ContrastScale),
               "sigma": field.get("Sigma"), "flow": field.get("Flow"),
               "labels": int(field.get(fm.names.Labels, 2)), "expansion_moves": field.get(fm.names.ExpansionMoves),
               "energy": field.get("Energy"),

@@ -91,6 +91,13 @@ struct Run
         return true;
     return false;
   }
+  bool HasWarning(const std::string& words) const
+  {
+    for (const auto& w : this->Log->Warnings)
+      if (w.find(words) != std::string::npos)
+        return true;
+    return false;
+  }
 };
 
 using Fill = std::function<double(int, int, int)>;
@@ -951,6 +958,43 @@ TEST(SuperVoxelCut, TaskOutOfRange)
   SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "task"); },
     [](vtkSuperVoxelCut* f) { f->SetTask(7); });
 }
+TEST(SuperVoxelCut, IntensityOutOfRange)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "intensity"); },
+    [](vtkSuperVoxelCut* f) { f->SetIntensity(3); });
+}
+TEST(SuperVoxelCut, ContrastScaleOutOfRange)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "contrast scale"); },
+    [](vtkSuperVoxelCut* f) { f->SetContrastScale(NaN); });
+}
+TEST(SuperVoxelCut, LocalContrastWithoutTheImage)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, nullptr, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "Image input"); },
+    [](vtkSuperVoxelCut* f) { f->SetIntensity(1); });
+}
+TEST(SuperVoxelCut, ClassTaskWithoutTheImageReadsTheMeans)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, nullptr, [&](auto& cut, const CutOutputs& out) {
+    ExpectGoodCut(cut, out, c.image, c.object, c.background);
+    EXPECT_TRUE(cut.HasWarning("MeanIntensity"));
+  },
+    [](vtkSuperVoxelCut* f) { f->SetTask(1); });
+}
+TEST(SuperVoxelCut, LocalContrastOfAConstantImage)
+{
+  // Every voxel's contrast is 0: no NaN from 0 / 0, a cut that keeps its seeds.
+  auto image = Image({ { 32, 32, 1 } }, [](int, int, int) { return 7.0; });
+  auto mesh = MeshOf(image);
+  auto object = Points({ World(image, 8, 8, 0) }), background = Points({ World(image, 24, 24, 0) });
+  SuperVoxelCut(mesh, object, background, image,
+    [&](auto& cut, const CutOutputs& out) { ASSERT_TRUE(cut.Log->Errors.empty()) << cut.Log->All(); (void)out; },
+    [](vtkSuperVoxelCut* f) { f->SetIntensity(1); });
+}
 TEST(SuperVoxelCut, NegativeGeodesicWeight)
 {
   Case2D c;
@@ -1109,6 +1153,24 @@ TEST(VoxelCut, TaskOutOfRange)
   auto image = Disc();
   VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "task", out); },
     [](vtkVoxelCut* f) { f->SetTask(-1); });
+}
+TEST(VoxelCut, IntensityOutOfRange)
+{
+  auto image = Disc();
+  VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "intensity", out); },
+    [](vtkVoxelCut* f) { f->SetIntensity(-1); });
+}
+TEST(VoxelCut, ContrastScaleOutOfRange)
+{
+  auto image = Disc();
+  VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "contrast scale", out); },
+    [](vtkVoxelCut* f) { f->SetContrastScale(1000); });
+}
+TEST(VoxelCut, LocalContrastOfAnInfiniteValue)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int i, int j, int) { return i == 5 && j == 5 ? INFINITY : (i < 16 ? 5.0 : 0.0); });
+  VoxelCut(image, Points({ World(image, 3, 3, 0) }), Points({ World(image, 30, 30, 0) }),
+    [](auto& run, vtkImageData* out) { ExpectError(run, "infinite", out); }, [](vtkVoxelCut* f) { f->SetIntensity(1); });
 }
 TEST(VoxelCut, NoBackgroundSeeds)
 {

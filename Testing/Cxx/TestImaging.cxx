@@ -25,6 +25,27 @@
 using namespace featuremesh;
 using namespace featuremesh_test;
 
+TEST(LocalContrast, IgnoresGainAndOffsetAndMarksTheDisk)
+{
+  const ImageGeometry g = Grid2(48, 48);
+  const std::vector<float> disk = Disk(g, 24, 24, 8);
+  std::vector<float> scaled(disk.size());
+  for (std::size_t v = 0; v < disk.size(); ++v)
+    scaled[v] = 3.0f * disk[v] - 500.0f;
+  std::vector<float> a(disk.size()), b(disk.size());
+  LocalContrast(disk.data(), a.data(), g, 6.0, SerialFor());
+  LocalContrast(scaled.data(), b.data(), g, 6.0, Chunked);
+  for (std::size_t v = 0; v < disk.size(); ++v)
+    EXPECT_NEAR(a[v], b[v], 1e-3) << v;
+  EXPECT_GT(a[g.Index(24, 24, 0)], 0.5f);
+  EXPECT_LT(a[g.Index(24, 34, 0)], -0.5f);
+  // A constant image has no contrast (and no 0 / 0).
+  const std::vector<float> flat(disk.size(), 7.0f);
+  LocalContrast(flat.data(), a.data(), g, 6.0, SerialFor());
+  for (float x : a)
+    EXPECT_EQ(x, 0.0f);
+}
+
 TEST(Canny, DiskGivesRingAtRadius)
 {
   const ImageGeometry g = Grid2(64, 64);

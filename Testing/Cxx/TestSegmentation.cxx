@@ -6,6 +6,7 @@
 #include "SeedGeodesics.h"
 #include "SuperVoxelCut.h"
 #include "ElementRasterizer.h"
+#include "ImageFilters.h"
 #include "DelaunayImageMesh.h"
 #include "TestHelpers.h"
 
@@ -708,6 +709,53 @@ TEST(Task, ObjectKeepsTheSeededDiskAndClassKeepsBoth)
       EXPECT_EQ((*label)[d.Right], task == Task::Class ? 1 : 0);
     }
     EXPECT_EQ(voxel.ObjectComponentVoxels.size(), task == Task::Class ? 2u : 1u);
+  }
+}
+
+TEST(Task, TheLocalContrastFindsEveryObjectOfAClassUnderShading)
+{
+  // Three disks, each 30 above a background that rises from 0 to 43 across the image; seeds by the
+  // left disk. The right background is as bright as the seeded disk and the right disk brighter
+  // than any seed: the image's values mislabel them, their local contrast (the filters' Intensity
+  // From Task for Task Class) does not. Both cuts, Task Class.
+  ImageGeometry g;
+  g.Dims = { { 72, 36, 1 } };
+  std::vector<float> image(g.Size());
+  for (int j = 0; j < 36; ++j)
+    for (int i = 0; i < 72; ++i)
+    {
+      const bool disk = std::hypot(i - 12, j - 18) <= 7 || std::hypot(i - 36, j - 18) <= 7 || std::hypot(i - 60, j - 18) <= 7;
+      image[g.Index(i, j, 0)] = 0.6f * i + (disk ? 30.f : 0.f);
+    }
+  const std::vector<std::int64_t> object = { g.Index(12, 18, 0) }, background = { g.Index(2, 2, 0), g.Index(12, 30, 0) };
+  const std::vector<std::int64_t> disks = { g.Index(12, 18, 0), g.Index(36, 18, 0), g.Index(60, 18, 0) };
+  const std::vector<std::int64_t> around = { g.Index(24, 18, 0), g.Index(48, 18, 0), g.Index(60, 32, 0), g.Index(70, 3, 0) };
+  std::vector<float> contrast(image.size());
+  LocalContrast(image.data(), contrast.data(), g, SeededCutParameters().ContrastScale, SerialFor());
+  for (const auto* values : { &image, &contrast })
+  {
+    const bool local = values == &contrast;
+    VoxelCutParameters vp;
+    vp.Task = Task::Class;
+    const CutResult voxel = VoxelCut(std::vector<double>(values->begin(), values->end()), g, object, background, vp);
+    ASSERT_TRUE(voxel.Error.empty()) << voxel.Error;
+    LatticeMesh m;
+    ASSERT_TRUE(m.Make(g, *values));
+    SuperVoxelCutParameters sp;
+    sp.Task = Task::Class;
+    const std::vector<std::uint8_t> super = m.Cut(*values, object, background, sp);
+    for (const auto* label : { &voxel.Label, &super })
+    {
+      int right = 0;
+      for (std::int64_t v : disks)
+        right += (*label)[v] == 1;
+      for (std::int64_t v : around)
+        right += (*label)[v] == 0;
+      if (local)
+        EXPECT_EQ(right, 7) << (label == &super ? "elements" : "voxels");
+      else
+        EXPECT_LT(right, 7) << (label == &super ? "elements" : "voxels");
+    }
   }
 }
 

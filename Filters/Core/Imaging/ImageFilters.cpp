@@ -321,6 +321,65 @@ void GaussianSmooth(const float* in, float* out, const ImageGeometry& g, double 
   });
 }
 
+void LocalContrast(const float* in, float* out, const ImageGeometry& g, double sigma, const ParallelFor& parallel)
+{
+  const std::int64_t n = g.Size();
+  if (n == 0)
+  {
+    return;
+  }
+  // Sums over fixed chunks, added in order: the same eps on any number of threads.
+  constexpr std::int64_t chunks = 64;
+  const std::int64_t per = (n + chunks - 1) / chunks;
+  std::vector<double> sum(chunks, 0.0), square(chunks, 0.0);
+  parallel(chunks, 1, [&](std::int64_t c0, std::int64_t c1) {
+    for (std::int64_t c = c0; c < c1; ++c)
+    {
+      for (std::int64_t v = c * per, end = std::min(n, v + per); v < end; ++v)
+      {
+        sum[c] += in[v];
+      }
+    }
+  });
+  double mean = 0.0;
+  for (double s : sum)
+  {
+    mean += s;
+  }
+  mean /= static_cast<double>(n);
+  parallel(chunks, 1, [&](std::int64_t c0, std::int64_t c1) {
+    for (std::int64_t c = c0; c < c1; ++c)
+    {
+      for (std::int64_t v = c * per, end = std::min(n, v + per); v < end; ++v)
+      {
+        square[c] += (in[v] - mean) * (in[v] - mean);
+      }
+    }
+  });
+  double variance = 0.0;
+  for (double s : square)
+  {
+    variance += s;
+  }
+  const float eps = std::max(std::numeric_limits<float>::min(), static_cast<float>(1e-3 * std::sqrt(variance / static_cast<double>(n))));
+  std::vector<float> local(n), spread(n);
+  GaussianSmooth(in, local.data(), g, sigma, parallel);
+  parallel(n, 65536, [&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t v = b; v < e; ++v)
+    {
+      out[v] = in[v] - local[v];
+      local[v] = out[v] * out[v];
+    }
+  });
+  GaussianSmooth(local.data(), spread.data(), g, sigma, parallel);
+  parallel(n, 65536, [&](std::int64_t b, std::int64_t e) {
+    for (std::int64_t v = b; v < e; ++v)
+    {
+      out[v] /= std::sqrt(spread[v]) + eps;
+    }
+  });
+}
+
 void GradientMagnitude(const float* f, const ImageGeometry& g, float* magnitude, const ParallelFor& parallel)
 {
   const std::int64_t sx = 1, sy = g.Dims[0], sz = g.SliceStride();

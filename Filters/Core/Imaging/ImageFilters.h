@@ -18,6 +18,12 @@ std::vector<float> GaussianKernel(double sigma);
 // sigma 0.7 on a 240x240x155 float volume, against a 0.6 s budget for the whole stage.
 void GaussianSmooth(const float* in, float* out, const ImageGeometry& grid, double sigma, const ParallelFor& parallel);
 
+// Local contrast: (I - G*I) / (sqrt(G*(I - G*I)^2) + eps), G the Gaussian of `sigma` voxels and
+// eps 1e-3 of the image's standard deviation (flat regions stay 0): each voxel's difference from
+// its neighbourhood's mean in units of the neighbourhood's spread. Shading and each object's own
+// brightness, which vary over more than sigma, drop out. `out` may not be `in`.
+void LocalContrast(const float* in, float* out, const ImageGeometry& grid, double sigma, const ParallelFor& parallel);
+
 // Standard deviation of the white noise in an image: the median absolute finest diagonal Haar
 // coefficient (2 x 2 (x 2) blocks) over 0.6745, Donoho and Johnstone's estimator (scikit-image's
 // estimate_sigma). Those coefficients vanish wherever the image is constant, or linear along an

@@ -183,6 +183,26 @@ double NodeVoxelValues::Value(std::int64_t v) const
   return VisitVoxelValues(*this, [v](const auto* values) { return static_cast<double>(values[v]); });
 }
 
+std::vector<double> NodeMeans(const NodeVoxelValues& grouped)
+{
+  std::vector<double> sum(grouped.Nodes, 0.0), count(grouped.Nodes, 0.0);
+  VisitVoxelValues(grouped, [&](const auto* values) {
+    for (std::int64_t v = 0; v < grouped.Voxels; ++v)
+    {
+      if (grouped.Owner[v] >= 0)
+      {
+        sum[grouped.Owner[v]] += static_cast<double>(values[v]);
+        count[grouped.Owner[v]] += 1.0;
+      }
+    }
+  });
+  for (std::int64_t p = 0; p < grouped.Nodes; ++p)
+  {
+    sum[p] = count[p] > 0.0 ? sum[p] / count[p] : 0.0;
+  }
+  return sum;
+}
+
 namespace
 {
 // Node p's values in ascending order at [Offset[p], Offset[p + 1]): a counting sort by node in a

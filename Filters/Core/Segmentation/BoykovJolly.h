@@ -88,6 +88,9 @@ bool GroupVoxelValues(const std::int32_t* owner, const T* values, std::int64_t v
   NodeVoxelValues& grouped, std::string& error, const ParallelFor& parallel, const ProgressFunction& progress = NoProgress(),
   std::shared_ptr<const void> keep = nullptr, std::int64_t sortedLimit = SortedVoxelLimit);
 
+// Each node's mean voxel value (0 for a node without voxels), summed in raster order.
+std::vector<double> NodeMeans(const NodeVoxelValues& grouped);
+
 struct CutProblem
 {
   std::vector<double> Value;   // intensity of each node (mean intensity for an element)

@@ -773,11 +773,11 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
   }
   // Samples: the voxels of the seed elements, or those within SeedRadius of each seed.
   std::vector<std::vector<double>> samples(L, std::vector<double>(bins.Count(), 0.0));
-  if (!par.SampleSeedElements)
+  if (!SamplesSeedElements(par))
   {
     SeedBallSamples(seeds, bins, mesh.Geometry(), par.SeedRadius, samples);
   }
-  for (std::int64_t p = 0; p < n && par.SampleSeedElements; ++p)
+  for (std::int64_t p = 0; p < n && SamplesSeedElements(par); ++p)
   {
     if (hard[p] >= 0)
     {

@@ -161,7 +161,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   if (data.HasVoxelValues())
   {
     const NodeVoxelValues& grouped = data.Voxels;
-    if (parameters.SampleSeedElements || !voxelValue)
+    if (SamplesSeedElements(parameters) || !voxelValue)
     {
       for (std::int64_t e = 0; e < m; ++e)
       {
@@ -251,6 +251,14 @@ std::string ValidateParameters(const SeededCutParameters& p)
   if (error.empty() && !(static_cast<int>(p.Connectivity) >= 0 && static_cast<int>(p.Connectivity) <= 3))
   {
     error = "the connectivity must be 0 (Off), 1 (Fill Holes), 2 (Seeded Object) or 3 (From Task).";
+  }
+  if (error.empty() && !(static_cast<int>(p.Intensity) >= 0 && static_cast<int>(p.Intensity) <= 2))
+  {
+    error = "the intensity must be 0 (Image), 1 (Local Contrast) or 2 (From Task).";
+  }
+  if (error.empty() && !(p.ContrastScale >= 0.5 && p.ContrastScale <= 100.0))
+  {
+    error = "the contrast scale must lie in [0.5, 100] voxels.";
   }
   if (error.empty())
   {

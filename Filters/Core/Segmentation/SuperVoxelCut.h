@@ -20,6 +20,18 @@
 
 namespace featuremesh
 {
+// What the cut reads at each voxel.
+enum class CutIntensity : int
+{
+  // The image's values.
+  Image = 0,
+  // Their local contrast (LocalContrast, ImageFilters.h): shading and each object's own brightness
+  // drop out, so a class of objects of varying brightness (nuclei, cells, vessels) shares one histogram.
+  LocalContrast = 1,
+  // Local Contrast for Task Class, the image's values for Task Object.
+  FromTask = 2,
+};
+
 // What both cuts share besides the energy.
 struct SeededCutParameters : BoykovJollyParameters
 {
@@ -33,7 +45,17 @@ struct SeededCutParameters : BoykovJollyParameters
   SeedGeodesicParameters Geodesic;
   // Radius (voxels) of the neighbourhood of each seed whose voxels build the histograms.
   double SeedRadius = 2.0;
+  // What the cut reads at each voxel, and the Gaussian scale (voxels) of the local contrast's
+  // neighbourhood: intensity changes over more than it count as shading (docs/cut.md).
+  CutIntensity Intensity = CutIntensity::FromTask;
+  double ContrastScale = 8.0;
 };
+
+// Whether the cut reads the local contrast (FromTask resolved).
+inline bool UsesLocalContrast(const SeededCutParameters& p)
+{
+  return p.Intensity == CutIntensity::LocalContrast || (p.Intensity == CutIntensity::FromTask && p.Task == Task::Class);
+}
 
 struct SuperVoxelCutParameters : SeededCutParameters
 {
@@ -45,9 +67,17 @@ struct SuperVoxelCutParameters : SeededCutParameters
   // its voxel count times the cost of its mean.
   bool VoxelRegionTerm = true;
   // The histograms' samples: the voxels of the elements that hold seeds (true), or those within
-  // SeedRadius of each seed voxel, as the voxel cut (false).
+  // SeedRadius of each seed voxel, as the voxel cut (false). The local contrast always takes the
+  // latter: the elements follow the image's edges, not its contrast, and on EM-02 its five seed
+  // elements held 25 voxels.
   bool SampleSeedElements = true;
 };
+
+// Whether the histograms sample the seed elements' voxels: SampleSeedElements, not with the local contrast.
+inline bool SamplesSeedElements(const SuperVoxelCutParameters& p)
+{
+  return p.SampleSeedElements && !UsesLocalContrast(p);
+}
 
 struct VoxelCutParameters : SeededCutParameters
 {
