@@ -152,9 +152,20 @@ vtkDataArray* LocalContrastArray::Of(
   result->SetName(values->GetName());
   result->SetNumberOfComponents(components);
   result->SetNumberOfTuples(n);
-  std::vector<float> channel(n), contrast(n);
+  if (components == 1)
+  {
+    // The array's own floats when it holds them: no copy in or out.
+    std::vector<float> storage;
+    const float* in = FloatValues(values, storage, error);
+    if (!in)
+    {
+      return nullptr;
+    }
+    LocalContrast(in, result->GetPointer(0), g, scale, parallel);
+  }
+  std::vector<float> channel(components > 1 ? n : 0), contrast(components > 1 ? n : 0);
   vtkIdType bad = 0;
-  for (int c = 0; c < components; ++c)
+  for (int c = 0; c < components && components > 1; ++c)
   {
     switch (values->GetDataType())
     {
