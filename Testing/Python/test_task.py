@@ -9,10 +9,11 @@ import fmtest as ft
 # on its local contrast) 0.873 / 0.858 (0.854 / 0.837 on its values; stage 3 at 3 sweeps; at 5: liver 0.888, BraTS-0005 0.832, BraTS-0006 0.915). Floors: the smoothed mesh's Dice minus 0.02. Before the term (Fill Holes for every
 # case): liver 0.868 / 0.859, BraTS-0005 0.640 / 0.505, BraTS-0006 0.906 / 0.907.
 FLOORS = {"liver-ct-totalseg": 0.868, "brain-tumour-brats-0005": 0.812, "brain-tumour-brats-0006": 0.895}
-# |Dice(smoothed) - Dice(Delaunay)|: 0.02 (the goal; nuclei 0.015, 0.022 on its values),
+# |Dice(smoothed) - Dice(Delaunay)|: 0.02 (the goal; nuclei 0.015, 0.022 on its values;
+# EM-03 0.003, 0.083 on its values),
 # except the liver, whose smoothed mesh is 0.021 better (0.017 at 5 sweeps), which may not widen
 # beyond 0.025.
-STABILITY = {"nuclei-dsb2018": 0.02, "liver-ct-totalseg": 0.025, "brain-tumour-brats-0005": 0.02,
+STABILITY = {"nuclei-dsb2018": 0.02, "em-isbi2012-03": 0.02, "liver-ct-totalseg": 0.025, "brain-tumour-brats-0005": 0.02,
              "brain-tumour-brats-0006": 0.02}
 
 for name, tolerance in STABILITY.items():
