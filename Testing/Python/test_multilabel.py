@@ -50,6 +50,20 @@ for name, folder in cases.items():
     ft.check(np.mean(vdice) >= FLOORS[name]["voxel"], "%s: voxel cut mean Dice %.3f >= %.3f" % (name, np.mean(vdice), FLOORS[name]["voxel"]))
     ft.check(min(dice) >= 0.55, "%s: every organ's Dice >= 0.55 (%.3f)" % (name, min(dice)))
 
+    # On the local contrast (Intensity 1) the labelled cut runs too, every seed holds and it stays
+    # an organ segmentation (mean Dice 0.722 measured; the values give 0.734).
+    local = case.super_voxel_cut(mesh, Intensity=1)
+    local.UpdatePipeline()
+    llabels = ft.fm.labels(local)
+    ldice = np.mean([ft.dice(llabels == l, truth == l) for l in range(1, k + 1)])
+    ft.check(ldice >= 0.70, "%s: on the local contrast mean Dice %.3f >= 0.70" % (name, ldice))
+    held = 0
+    for x, y, z, label in case.seed_rows():
+        ijk = [0.0, 0.0, 0.0]
+        image.TransformPhysicalPointToContinuousIndex([x, y, z], ijk)
+        i, j, kk = (int(np.floor(c + 0.5)) for c in ijk)
+        held += llabels[(kk * dims[1] + j) * dims[0] + i] == label
+    ft.check(held == len(case.seed_rows()), "%s: on the local contrast every seed keeps its label" % name)
     # A seed edit: one more liver seed; only the cut re-runs, and the seeds still hold.
     rows = case.seed_rows() + [(case.seed_rows()[0][0] + 6.0, case.seed_rows()[0][1], case.seed_rows()[0][2], 1)]
     path = os.path.join(tempfile.mkdtemp(prefix="featuremesh-multilabel-"), "seeds.csv")
