@@ -1,4 +1,5 @@
 #include "vtkFeatureMeshArrays.h"
+#include "vtkFeatureMeshExecution.h"
 #include "vtkFeatureMeshFrame.h"
 
 #include "Contract.h"
@@ -199,6 +200,21 @@ vtkDataArray* LocalContrastArray::Of(
   this->Frame = g;
   this->Result = result;
   return this->Result;
+}
+
+vtkDataArray* CutValues(vtkDataArray* values, bool contrast, const ImageGeometry& g, double scale,
+  std::unique_ptr<LocalContrastArray>& kept, std::string& error)
+{
+  if (!contrast || !values)
+  {
+    kept.reset();
+    return values;
+  }
+  if (!kept)
+  {
+    kept = std::make_unique<LocalContrastArray>();
+  }
+  return kept->Of(values, g, scale, SMPParallelFor(), error);
 }
 
 bool ToDouble(vtkDataArray* array, std::vector<double>& values, std::string& error)

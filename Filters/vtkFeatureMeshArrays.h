@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <initializer_list>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -56,6 +57,12 @@ private:
   ImageGeometry Frame;
   vtkSmartPointer<vtkFloatArray> Result;
 };
+
+// The array a seeded cut reads: `values`, or with `contrast` its local contrast, kept in `kept` (made
+// when first needed, released when the cut reads the values again). Null (with `values` null)
+// passes through; null with `error` set when the contrast cannot be made.
+vtkDataArray* CutValues(vtkDataArray* values, bool contrast, const ImageGeometry& geometry, double scale,
+  std::unique_ptr<LocalContrastArray>& kept, std::string& error);
 
 // The image as the filters read it: values on voxel centres (point data). An image whose values
 // are cell data (each cell a voxel, as ParaView's GDAL reader gives a PNG or TIFF) becomes the image

@@ -162,17 +162,10 @@ int vtkSuperVoxelCut::RequestData(
     {
       this->Warn("Task Class reads the image's local contrast; without the Image input the cut reads the elements' MeanIntensity.");
     }
-    if (contrast && valuesArray)
+    valuesArray = CutValues(valuesArray, contrast, geometry, this->ContrastScale, this->Contrast, error);
+    if (image && !valuesArray)
     {
-      if (!this->Contrast)
-      {
-        this->Contrast = std::make_unique<LocalContrastArray>();
-      }
-      valuesArray = this->Contrast->Of(valuesArray, geometry, this->ContrastScale, SMPParallelFor(), error);
-      if (!valuesArray)
-      {
-        return this->Fail(error);
-      }
+      return this->Fail(error);
     }
     if (!labelledSeeds && (!objectSeeds || !backgroundSeeds))
     {

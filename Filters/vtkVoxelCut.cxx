@@ -83,17 +83,9 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     }
     const VoxelCutParameters& par = *this;
     std::string error;
-    if (UsesLocalContrast(par))
+    if (!(array = CutValues(array, UsesLocalContrast(par), geometry, this->ContrastScale, this->Contrast, error)))
     {
-      if (!this->Contrast)
-      {
-        this->Contrast = std::make_unique<LocalContrastArray>();
-      }
-      array = this->Contrast->Of(array, geometry, this->ContrastScale, SMPParallelFor(), error);
-      if (!array)
-      {
-        return this->Fail(error);
-      }
+      return this->Fail(error);
     }
     std::vector<std::int64_t> objectVoxels, backgroundVoxels;
     if (labelledSeeds)

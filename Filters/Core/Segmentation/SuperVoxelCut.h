@@ -68,8 +68,8 @@ struct SuperVoxelCutParameters : SeededCutParameters
   bool VoxelRegionTerm = true;
   // The histograms' samples: the voxels of the elements that hold seeds (true), or those within
   // SeedRadius of each seed voxel, as the voxel cut (false). The local contrast always takes the
-  // latter: the elements follow the image's edges, not its contrast, and on EM-02 its five seed
-  // elements held 25 voxels.
+  // latter: the elements follow the image's edges, not its contrast, and small seed elements give
+  // too few samples of it.
   bool SampleSeedElements = true;
 };
 
