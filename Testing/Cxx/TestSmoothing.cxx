@@ -296,6 +296,45 @@ TEST(SliverFlips, TwoThreeFlipReplacesAFlatTetrahedron)
   EXPECT_EQ(cells, flipped);
 }
 
+TEST(ImageMeshSmoothing, TheLastResortMovesTheFixedVerticesOfASliver)
+{
+  // The box's corners and four nearly cocircular nodes, all fixed: their Delaunay tetrahedron is
+  // a sliver no free vertex can mend. The last resort moves them (the corners stay) until every
+  // tetrahedron reaches 10 degrees, keeps every element positive and the box tiled.
+  ImageGeometry g;
+  g.Dims = { { 11, 11, 11 } };
+  std::vector<std::array<double, 3>> pts = { { { 4, 4, 5 } }, { { 6, 4, 5.125 } }, { { 6, 6, 5 } }, { { 4, 6, 5.125 } } };
+  for (int c = 0; c < 8; ++c)
+    pts.push_back({ { c & 1 ? 10.0 : 0.0, c & 2 ? 10.0 : 0.0, c & 4 ? 10.0 : 0.0 } });
+  SimplexMesh mesh;
+  ASSERT_TRUE(CGALMeshOfNodes(g, pts, mesh));
+  ASSERT_LT(MinimumAngle(mesh), 10.0);
+  const SimplexMesh before = mesh;
+  std::int64_t moved = 0;
+  // More slivers than allowed: the mesh is left as it was.
+  EXPECT_FALSE(PerturbSliverVertices(mesh, 10.0, 0, moved));
+  EXPECT_EQ(moved, 0);
+  EXPECT_EQ(mesh.Points(), before.Points());
+  EXPECT_TRUE(PerturbSliverVertices(mesh, 10.0, 64, moved));
+  EXPECT_GT(moved, 0);
+  EXPECT_GE(MinimumAngle(mesh), 10.0);
+  EXPECT_EQ(mesh.Cells(), before.Cells());
+  double volume = 0.0;
+  for (std::int64_t e = 0; e < mesh.NumberOfElements(); ++e)
+  {
+    const std::array<double, 3>* v[4];
+    for (int k = 0; k < 4; ++k)
+      v[k] = &mesh.Points()[mesh.Cell(e)[k]];
+    EXPECT_GT(SimplexMeasure(v, 4), 0.0) << e;
+    volume += SimplexMeasure(v, 4);
+  }
+  EXPECT_NEAR(volume, 1000.0, 1e-9);
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    for (int a = 0; a < 3; ++a)
+      if (before.Points()[i][a] == 0.0 || before.Points()[i][a] == 10.0)
+        EXPECT_EQ(mesh.Points()[i][a], before.Points()[i][a]) << i;
+}
+
 TEST(SliverFlips, ThreeTwoFlipRemovesAnEdge)
 {
   // Three tetrahedra around the edge 3-4, which crosses the triangle 0-1-2 near its side 0-1: the

@@ -102,9 +102,9 @@ for case in CASES:
     two = ft.run_script_with_backend(__file__, "STDThread", case)
     ft.check(one == two == digest, "%s: identical with 1 thread (Sequential) and 2 threads (STDThread)" % case)
 
-# The second refinement run (docs/smoothing.md): at 4 sweeps TetGen's optimisation leaves a
-# tetrahedron of four Canny nodes at 8.7 degrees on BraTS-0005 that no flip improves; refinement
-# and sliver removal run again with TetGen's own target and the bound holds.
+# The last resort (docs/smoothing.md): at 4 sweeps TetGen's optimisation leaves a tetrahedron of
+# four Canny nodes at 8.7 degrees on BraTS-0005 that no flip improves; its vertices, fixed ones
+# included, take perturbation's steps and the bound holds without a second refinement run.
 case = "brain-tumour-brats-0005"
 if ft.fm.case_dir(case) is None:
     print("SKIP %s: not found (bundled Data/ or ../shared/data/cases)" % case)
@@ -115,4 +115,4 @@ else:
     ug = ft.fetch(out)
     q = metrics.mesh_quality(ft.v2n(ug.GetPoints().GetData()), cells(ug))
     runs = ug.GetFieldData().GetArray(ft.names.RefinementRuns).GetValue(0)
-    ft.check(runs == 2 and q["min"] >= 10.0, "%s, 4 sweeps: %d refinement runs, smallest dihedral %.2f (>= 10)" % (case, runs, q["min"]))
+    ft.check(runs == 1 and q["min"] >= 10.0, "%s, 4 sweeps: %d refinement run, smallest dihedral %.2f (>= 10)" % (case, runs, q["min"]))

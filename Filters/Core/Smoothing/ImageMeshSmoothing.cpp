@@ -977,6 +977,56 @@ bool RemoveSlivers(Smoother& s, double sliverAngle, const ParallelFor& parallel,
   return true;
 }
 
+// The last resort for a few tetrahedra still under `degrees` after flips and perturbation: four fixed
+// (feature) nodes that no flip improves. Their vertices, fixed ones included (off the image box's
+// faces only within them), take perturbation's short steps, up to three rounds. True when every
+// element then reaches `degrees`; false at once when more than `most` miss it (for those steps 4-5
+// run again). Far cheaper than running them again for one tetrahedron of millions.
+bool MoveFixedAroundSlivers(Smoother& s, double degrees, std::int64_t most, std::int64_t& moved)
+{
+  const double threshold = AngleScoreAt(degrees);
+  const ImageGeometry& g = s.Topology.Geometry();
+  auto below = [&]() {
+    std::vector<std::int64_t> bad;
+    for (std::int64_t e = 0; e < s.Topology.NumberOfElements(); ++e)
+    {
+      if (ElementScore(s, e) < threshold)
+      {
+        bad.push_back(e);
+      }
+    }
+    return bad;
+  };
+  std::vector<std::int64_t> bad = below();
+  if (static_cast<std::int64_t>(bad.size()) > most)
+  {
+    return false;
+  }
+  for (int round = 0; round < 3 && !bad.empty(); ++round)
+  {
+    for (const std::int64_t e : bad)
+    {
+      for (int k = 0; k < 4 && ElementScore(s, e) < threshold; ++k)
+      {
+        const std::int64_t v = s.Topology.Cell(e)[k];
+        const std::uint8_t free = s.Free[v];
+        for (int a = 0; a < 3; ++a)
+        {
+          if (s.Points[v][a] != 0.0 && s.Points[v][a] != g.Dims[a] - 1.0)
+          {
+            s.Free[v] |= static_cast<std::uint8_t>(1 << a);
+          }
+        }
+        moved += PerturbVertex(s, v, threshold) ? 1 : 0;
+        s.Free[v] = free;
+      }
+    }
+    bad = below();
+  }
+  s.Topology.SetPoints(s.Points);
+  return bad.empty();
+}
+
 // True when every element's smallest dihedral angle is at least `degrees`.
 bool ReachesAngle(const Smoother& s, double degrees)
 {
@@ -991,6 +1041,15 @@ bool ReachesAngle(const Smoother& s, double degrees)
   return true;
 }
 } // namespace
+
+bool PerturbSliverVertices(SimplexMesh& mesh, double degrees, std::int64_t most, std::int64_t& moved)
+{
+  // Every node counts as fixed: the last resort frees what it moves.
+  Smoother s(mesh, std::vector<std::uint8_t>(mesh.NumberOfPoints(), 0));
+  const bool reached = MoveFixedAroundSlivers(s, degrees, most, moved);
+  mesh = std::move(s.Topology);
+  return reached;
+}
 
 ImageMeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, const float* values,
   const ImageMeshSmoothingParameters& p, const ParallelFor& parallel, const ProgressFunction& progress)
@@ -1073,7 +1132,8 @@ ImageMeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vec
       return result;
     }
     result.SliverSeconds += since(t0);
-    if (swept.empty() || maxDihedral == tetgenOwn || ReachesAngle(s, p.MinDihedralAngle - 0.5))
+    if (swept.empty() || maxDihedral == tetgenOwn || ReachesAngle(s, p.MinDihedralAngle - 0.5) ||
+      (perturb && MoveFixedAroundSlivers(s, p.MinDihedralAngle - 0.5, 64, result.Perturbed)))
     {
       break;
     }

@@ -104,4 +104,11 @@ struct ImageMeshSmoothingResult
 ImageMeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vector<std::uint8_t>& fixed, const float* values,
   const ImageMeshSmoothingParameters& parameters, const ParallelFor& parallel,
   const ProgressFunction& progress = NoProgress());
+
+// Stage 3's last resort after refinement, flips and perturbation: the vertices of the tetrahedra
+// whose smallest dihedral angle is under `degrees` take perturbation's short steps, fixed ones
+// included (nodes on the image box's faces within them), up to three rounds. False, with `mesh`
+// as it was, when more than `most` tetrahedra are under it; else whether all now reach it.
+// `moved` counts the moves.
+bool PerturbSliverVertices(SimplexMesh& mesh, double degrees, std::int64_t most, std::int64_t& moved);
 } // namespace featuremesh
