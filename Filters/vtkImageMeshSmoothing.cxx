@@ -191,6 +191,7 @@ void vtkImageMeshSmoothing::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "QualityRefinement: " << this->QualityRefinement << "\n";
   os << indent << "MinAngle: " << this->MinAngle << "\n";
   os << indent << "MinDihedralAngle: " << this->MinDihedralAngle << "\n";
+  os << indent << "DihedralFloor: " << this->DihedralFloor << "\n";
   os << indent << "SliverRemoval: " << this->SliverRemoval << "\n";
   os << indent << "MaxDihedralAngle: " << this->MaxDihedralAngle << "\n";
   os << indent << "SliverAngle: " << this->SliverAngle << "\n";

@@ -62,7 +62,7 @@ public:
   vtkGetMacro(Flips, bool);
   vtkBooleanMacro(Flips, bool);
   /// Add nodes (Delaunay refinement) where elements stay below MinAngle (2D, default 20 degrees)
-  /// or MinDihedralAngle (3D, default 10.5 degrees) after the sweeps; in 3D TetGen's optimisation
+  /// or MinDihedralAngle (3D, default 9 degrees) after the sweeps; in 3D TetGen's optimisation
   /// then flips tetrahedra with a dihedral angle above MaxDihedralAngle (default 150). On by default.
   vtkSetMacro(QualityRefinement, bool);
   vtkGetMacro(QualityRefinement, bool);
@@ -80,6 +80,11 @@ public:
   vtkBooleanMacro(SliverRemoval, bool);
   vtkSetMacro(SliverAngle, double);
   vtkGetMacro(SliverAngle, double);
+  /// 3D: the smallest dihedral angle the mesh keeps after refinement and sliver removal (default
+  /// 10 degrees): a few tetrahedra under it get their vertices moved, fixed ones included; more,
+  /// and refinement and sliver removal run again.
+  vtkSetMacro(DihedralFloor, double);
+  vtkGetMacro(DihedralFloor, double);
 
   void SetImageConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(1, output); }
 

@@ -1357,6 +1357,12 @@ TEST(ImageMeshSmoothing, OptimisationAngleOutOfRange)
   Smoothing(MeshOf(image), image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "maximum dihedral", out); },
     [](vtkImageMeshSmoothing* s) { s->SetMaxDihedralAngle(NaN); });
 }
+TEST(ImageMeshSmoothing, DihedralFloorOutOfRange)
+{
+  auto image = Disc();
+  Smoothing(MeshOf(image), image, [](auto& run, vtkUnstructuredGrid* out) { ExpectError(run, "dihedral floor", out); },
+    [](vtkImageMeshSmoothing* s) { s->SetDihedralFloor(30); });
+}
 TEST(ImageMeshSmoothing, MeshWithoutFixedArrayMovesEveryNodeButTheCorners)
 {
   auto image = Disc();

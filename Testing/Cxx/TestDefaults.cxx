@@ -93,6 +93,7 @@ int main(int argc, char* argv[])
     GETTER(vtkImageMeshSmoothing, QualityRefinement), GETTER(vtkImageMeshSmoothing, MinAngle),
     GETTER(vtkImageMeshSmoothing, MinDihedralAngle), GETTER(vtkImageMeshSmoothing, SliverRemoval),
     GETTER(vtkImageMeshSmoothing, MaxDihedralAngle), GETTER(vtkImageMeshSmoothing, SliverAngle),
+    GETTER(vtkImageMeshSmoothing, DihedralFloor),
     GETTER(vtkSuperVoxelCut, Lambda), GETTER(vtkSuperVoxelCut, Sigma), GETTER(vtkSuperVoxelCut, Bins),
     GETTER(vtkSuperVoxelCut, ScaleByContact), GETTER(vtkSuperVoxelCut, VoxelRegionTerm),
     GETTER(vtkSuperVoxelCut, Connectivity), GETTER(vtkSuperVoxelCut, Bandwidth),

@@ -592,6 +592,10 @@ std::string ValidateParameters(const ImageMeshSmoothingParameters& p)
   {
     return "the refinement's minimum dihedral angle must be in [0, 30) degrees.";
   }
+  if (!(p.DihedralFloor >= 0.0 && p.DihedralFloor < 30.0))
+  {
+    return "the dihedral floor must be in [0, 30) degrees.";
+  }
   if (!(p.MaxDihedralAngle >= 120.0 && p.MaxDihedralAngle <= 179.0))
   {
     return "the optimisation's maximum dihedral angle must be in [120, 179] degrees.";
@@ -1111,9 +1115,9 @@ ImageMeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vec
   }
   std::vector<float>().swap(images.Gradient);
   result.SweepSeconds = since(t0);
-  // TetGen's optimisation flips by the largest dihedral angle and can undercut the bound on the
-  // smallest: when the finished mesh misses it by more than half a degree, steps 4-5 run again on
-  // the swept nodes with TetGen's own optimisation target.
+  // TetGen's optimisation flips by the largest dihedral angle and can undercut the smallest: when
+  // the finished mesh misses DihedralFloor and the last resort cannot mend it, steps 4-5 run again
+  // on the swept nodes with TetGen's own optimisation target.
   const double tetgenOwn = DelaunayImageMeshParameters().MaxDihedralAngle;
   const std::vector<V3> swept = vpc == 4 && refine && p.MaxDihedralAngle < tetgenOwn ? s.Points : std::vector<V3>();
   for (double maxDihedral = p.MaxDihedralAngle;; maxDihedral = tetgenOwn)
@@ -1132,8 +1136,8 @@ ImageMeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vec
       return result;
     }
     result.SliverSeconds += since(t0);
-    if (swept.empty() || maxDihedral == tetgenOwn || ReachesAngle(s, p.MinDihedralAngle - 0.5) ||
-      (perturb && MoveFixedAroundSlivers(s, p.MinDihedralAngle - 0.5, 64, result.Perturbed)))
+    if (swept.empty() || maxDihedral == tetgenOwn || ReachesAngle(s, p.DihedralFloor) ||
+      (perturb && MoveFixedAroundSlivers(s, p.DihedralFloor, 64, result.Perturbed)))
     {
       break;
     }
