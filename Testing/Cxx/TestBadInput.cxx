@@ -42,6 +42,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace
@@ -958,23 +959,20 @@ TEST(SuperVoxelCut, TaskOutOfRange)
   SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "task"); },
     [](vtkSuperVoxelCut* f) { f->SetTask(7); });
 }
-TEST(SuperVoxelCut, IntensityOutOfRange)
+TEST(SuperVoxelCut, BadIntensityParameters)
 {
+  // Each with its words; the local contrast without the Image input too.
   Case2D c;
-  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "intensity"); },
-    [](vtkSuperVoxelCut* f) { f->SetIntensity(3); });
-}
-TEST(SuperVoxelCut, ContrastScaleOutOfRange)
-{
-  Case2D c;
-  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "contrast scale"); },
-    [](vtkSuperVoxelCut* f) { f->SetContrastScale(NaN); });
-}
-TEST(SuperVoxelCut, LocalContrastWithoutTheImage)
-{
-  Case2D c;
-  SuperVoxelCut(c.mesh, c.object, c.background, nullptr, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "Image input"); },
-    [](vtkSuperVoxelCut* f) { f->SetIntensity(1); });
+  const std::vector<std::tuple<std::function<void(vtkSuperVoxelCut*)>, std::string, bool>> cases = {
+    { [](vtkSuperVoxelCut* f) { f->SetIntensity(3); }, "intensity", true },
+    { [](vtkSuperVoxelCut* f) { f->SetIntensity(-1); }, "intensity", true },
+    { [](vtkSuperVoxelCut* f) { f->SetContrastScale(NaN); }, "contrast scale", true },
+    { [](vtkSuperVoxelCut* f) { f->SetContrastScale(0.1); }, "contrast scale", true },
+    { [](vtkSuperVoxelCut* f) { f->SetIntensity(1); }, "Image input", false },
+  };
+  for (const auto& [set, words, image] : cases)
+    SuperVoxelCut(c.mesh, c.object, c.background, image ? c.image.GetPointer() : nullptr,
+      [&](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, words); }, set);
 }
 TEST(SuperVoxelCut, ClassTaskWithoutTheImageReadsTheMeans)
 {
@@ -1154,17 +1152,16 @@ TEST(VoxelCut, TaskOutOfRange)
   VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "task", out); },
     [](vtkVoxelCut* f) { f->SetTask(-1); });
 }
-TEST(VoxelCut, IntensityOutOfRange)
+TEST(VoxelCut, BadIntensityParameters)
 {
   auto image = Disc();
-  VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "intensity", out); },
-    [](vtkVoxelCut* f) { f->SetIntensity(-1); });
-}
-TEST(VoxelCut, ContrastScaleOutOfRange)
-{
-  auto image = Disc();
-  VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "contrast scale", out); },
-    [](vtkVoxelCut* f) { f->SetContrastScale(1000); });
+  const std::vector<std::pair<std::function<void(vtkVoxelCut*)>, std::string>> cases = {
+    { [](vtkVoxelCut* f) { f->SetIntensity(-1); }, "intensity" },
+    { [](vtkVoxelCut* f) { f->SetContrastScale(1000); }, "contrast scale" },
+  };
+  for (const auto& c : cases)
+    VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [&](auto& run, vtkImageData* out) { ExpectError(run, c.second, out); },
+      c.first);
 }
 TEST(VoxelCut, LocalContrastOfAnInfiniteValue)
 {
