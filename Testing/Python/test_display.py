@@ -37,7 +37,8 @@ def unconnected(xml_name):
 for name, make, want in (
         ("Delaunay Image Mesh", "DelaunayImageMesh", {"3D images only (tetrahedra)": ["Backend", "QualityRefinement", "RadiusEdgeRatio", "MinDihedralAngle"]}),
         ("Image Mesh Smoothing", "ImageMeshSmoothing", {"2D images only (triangles)": ["MinAngle"],
-                                                            "3D images only (tetrahedra)": ["MinDihedralAngle", "MaxDihedralAngle", "SliverRemoval", "SliverAngle"]})):
+                                                            "3D images only (tetrahedra)": ["MinDihedralAngle", "MaxDihedralAngle", "SliverRemoval", "SliverAngle",
+                                                                                            "DihedralFloor"]})):
     proxy = unconnected(make)
     groups = {}
     for g in range(proxy.GetNumberOfPropertyGroups()):

@@ -37,7 +37,8 @@ def field(data, name):
 for name in ("SuperVoxelCut", "VoxelCut"):
     results = {}
     for mode in (None, 0, 1, 2, "class"):
-        props = {} if mode is None else ({"Task": "Class"} if mode == "class" else {"Connectivity": mode})
+        # Task Class on the image's values (its default reads their local contrast): the rule alone differs.
+        props = {} if mode is None else ({"Task": "Class", "Intensity": "Image"} if mode == "class" else {"Connectivity": mode})
         if name == "SuperVoxelCut":
             cut = ft.SuperVoxelCut(Mesh=mesh, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, **props)
             out = ft.fetch(cut, 2)
