@@ -153,45 +153,31 @@ vtkDataArray* LocalContrastArray::Of(
   result->SetName(values->GetName());
   result->SetNumberOfComponents(components);
   result->SetNumberOfTuples(n);
-  if (components == 1)
+  // One component: the array's own floats when it holds them, the contrast written in place. More:
+  // each component as a float array of the array's name (checked as any image array is), then
+  // interleaved.
+  vtkNew<vtkFloatArray> channel;
+  std::vector<float> storage, contrast(components > 1 ? n : 0);
+  for (int c = 0; c < components; ++c)
   {
-    // The array's own floats when it holds them: no copy in or out.
-    std::vector<float> storage;
-    const float* in = FloatValues(values, storage, error);
+    vtkDataArray* one = values;
+    if (components > 1)
+    {
+      channel->SetName(values->GetName());
+      channel->SetNumberOfTuples(n);
+      channel->CopyComponent(0, values, c);
+      one = channel;
+    }
+    const float* in = FloatValues(one, storage, error);
     if (!in)
     {
       return nullptr;
     }
-    LocalContrast(in, result->GetPointer(0), g, scale, parallel);
-  }
-  std::vector<float> channel(components > 1 ? n : 0), contrast(components > 1 ? n : 0);
-  vtkIdType bad = 0;
-  for (int c = 0; c < components && components > 1; ++c)
-  {
-    switch (values->GetDataType())
+    float* out = components > 1 ? contrast.data() : result->GetPointer(0);
+    LocalContrast(in, out, g, scale, parallel);
+    for (vtkIdType i = 0; i < n && components > 1; ++i)
     {
-      vtkTemplateMacro(const VTK_TT* v = static_cast<const VTK_TT*>(values->GetVoidPointer(0));
-                       for (vtkIdType i = 0; i < n; ++i) {
-                         const double x = static_cast<double>(v[i * components + c]);
-                         const bool ok = std::isfinite(x) && std::fabs(x) <= 3.4e38;
-                         bad += ok ? 0 : 1;
-                         channel[i] = ok ? static_cast<float>(x) : 0.0f;
-                       });
-      default:
-        error = "the array's value type is not supported.";
-        return nullptr;
-    }
-    if (bad)
-    {
-      error = std::string("the array '") + (values->GetName() ? values->GetName() : "") + "' holds " +
-        std::to_string(bad) + " values that are NaN, infinite or beyond +-3.4e38; replace or rescale them first.";
-      return nullptr;
-    }
-    LocalContrast(channel.data(), contrast.data(), g, scale, parallel);
-    float* out = result->GetPointer(0);
-    for (vtkIdType i = 0; i < n; ++i)
-    {
-      out[i * components + c] = contrast[i];
+      result->SetValue(i * components + c, contrast[i]);
     }
   }
   this->Source = values;

@@ -985,7 +985,8 @@ bool RemoveSlivers(Smoother& s, double sliverAngle, const ParallelFor& parallel,
 // (feature) nodes that no flip improves. Their vertices, fixed ones included (off the image box's
 // faces only within them), take perturbation's short steps, up to three rounds. True when every
 // element then reaches `degrees`; false at once when more than `most` miss it (for those steps 4-5
-// run again). Far cheaper than running them again for one tetrahedron of millions.
+// run again); true at once, nothing moved, when none is under it. Far cheaper than running steps
+// 4-5 again for one tetrahedron of millions.
 bool MoveFixedAroundSlivers(Smoother& s, double degrees, std::int64_t most, std::int64_t& moved)
 {
   const double threshold = AngleScoreAt(degrees);
@@ -1002,9 +1003,9 @@ bool MoveFixedAroundSlivers(Smoother& s, double degrees, std::int64_t most, std:
     return bad;
   };
   std::vector<std::int64_t> bad = below();
-  if (static_cast<std::int64_t>(bad.size()) > most)
+  if (bad.empty() || static_cast<std::int64_t>(bad.size()) > most)
   {
-    return false;
+    return bad.empty();
   }
   for (int round = 0; round < 3 && !bad.empty(); ++round)
   {
@@ -1136,8 +1137,9 @@ ImageMeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vec
       return result;
     }
     result.SliverSeconds += since(t0);
-    if (swept.empty() || maxDihedral == tetgenOwn || ReachesAngle(s, p.DihedralFloor) ||
-      (perturb && MoveFixedAroundSlivers(s, p.DihedralFloor, 64, result.Perturbed)))
+    // One scan of the elements: the last resort returns at once when none is under the floor.
+    if (swept.empty() || maxDihedral == tetgenOwn ||
+      (perturb ? MoveFixedAroundSlivers(s, p.DihedralFloor, 64, result.Perturbed) : ReachesAngle(s, p.DihedralFloor)))
     {
       break;
     }
