@@ -5,6 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 cd build
-xvfb-run -a ctest --output-on-failure -j1
+# -noreset: Xvfb otherwise resets when its last client leaves and drops a client connecting meanwhile
+# ("bad X server connection", seen once in CI).
+xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" ctest --output-on-failure -j1
 cd ..
 bash scripts/run_sanitizers.sh

@@ -210,6 +210,7 @@ ft.check(cells_with(empty, sb) == 0, "no object seeds: error")
 ft.check(cells_with(so, empty) == 0, "only one class of seeds: error")
 bare = ft.PassArrays(Input=mesh, CellDataArrays=[ft.names.PixelCount], PointDataArrays=[], FieldDataArrays=[])
 ft.check(cells_with(so, sb, bare) == 0, "a mesh without MeanIntensity: error")
+ft.finish()  # exits on a failure, so the line below is true
 print("all cut checks passed")
 
 # Stage 3 rasterises its own moved mesh, so it asks its input for no owner map. Built and updated at

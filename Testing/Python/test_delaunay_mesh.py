@@ -83,6 +83,7 @@ flat = ft.PolyPointSource(Points=[0, 0, 0, 30, 0, 0, 0, 30, 0, 30, 30, 0, 12, 9,
 m3 = ft.DelaunayImageMesh(Nodes=flat, Image=image3)
 m3.UpdatePipeline()
 ft.check(ft.fetch(m3).GetNumberOfCells() == 0, "coplanar nodes in 3D: error")
+ft.finish()  # exits on a failure, so the line below is true
 print("all mesh checks passed")
 
 # Quality refinement (TetGen with the box as its domain) on the 3D cases: the requested minimum
