@@ -26,6 +26,7 @@
 #include "vtkUnstructuredGrid.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 vtkStandardNewMacro(vtkSuperVoxelCut);
@@ -48,6 +49,15 @@ struct vtkSuperVoxelCut::MeshData
   featuremesh::MultiLabelCache Multi;
   // Whether the voxel owners came from the mesh's own map (stage 2 or 3) instead of a rasterisation.
   bool OwnerMapReused = false;
+  // The label images of the last two cuts and the element labels each holds: a re-cut rewrites the
+  // one no one else holds (output 2 holds the last) where labels changed, not every voxel.
+  struct LabelImage
+  {
+    vtkSmartPointer<vtkUnsignedCharArray> Voxels;
+    std::vector<std::uint8_t> Labels;
+  };
+  std::array<LabelImage, 2> LabelImages;
+  int LastLabelImage = 0;
 
   MeshData(std::initializer_list<vtkObject*> sources, const featuremesh::ImageGeometry& frame)
     : Frame(frame)
@@ -324,7 +334,7 @@ void vtkSuperVoxelCut::WriteLabels(vtkUnstructuredGrid* input, const std::vector
   const std::vector<std::int64_t>& boundaryFaces, vtkInformationVector* outputVector)
 {
   using namespace featuremesh;
-  const MeshData& data = *this->Prepared;
+  MeshData& data = *this->Prepared;
   const ImageGeometry& geometry = data.Mesh.Geometry();
   // Output 0: the mesh with labels.
   vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
@@ -346,11 +356,7 @@ void vtkSuperVoxelCut::WriteLabels(vtkUnstructuredGrid* input, const std::vector
   labelImage->GetFieldData()->Initialize();
   vtkPolyData::GetData(outputVector, 1)->GetFieldData()->Initialize();
   SetImageFrame(labelImage, geometry);
-  vtkNew<vtkUnsignedCharArray> voxels;
-  voxels->SetName(names::Label);
-  voxels->SetNumberOfTuples(geometry.Size());
-  VoxelLabels(data.Cut.Owner, labels, voxels->GetPointer(0), SMPParallelFor());
-  labelImage->GetPointData()->SetScalars(voxels);
+  labelImage->GetPointData()->SetScalars(this->LabelVoxels(labels));
   if (this->SuperVoxelIds)
   {
     vtkNew<vtkIdTypeArray> ids;
@@ -359,6 +365,36 @@ void vtkSuperVoxelCut::WriteLabels(vtkUnstructuredGrid* input, const std::vector
     std::copy(data.Cut.Owner.begin(), data.Cut.Owner.end(), ids->GetPointer(0));
     labelImage->GetPointData()->AddArray(ids);
   }
+}
+
+vtkUnsignedCharArray* vtkSuperVoxelCut::LabelVoxels(const std::vector<std::uint8_t>& labels)
+{
+  using namespace featuremesh;
+  MeshData& data = *this->Prepared;
+  const std::int64_t size = data.Mesh.Geometry().Size();
+  auto free = [&](int slot) {
+    const auto& voxels = data.LabelImages[slot].Voxels;
+    return voxels && voxels->GetReferenceCount() == 1 && voxels->GetNumberOfTuples() == size;
+  };
+  // The last cut's image when no one holds it (the fewest changes), else the one before.
+  const int last = data.LastLabelImage;
+  int slot = free(last) ? last : free(1 - last) ? 1 - last : -1;
+  if (slot < 0)
+  {
+    slot = 1 - last; // both held elsewhere, or none yet: a new array
+    data.LabelImages[slot].Voxels = vtkSmartPointer<vtkUnsignedCharArray>::New();
+    data.LabelImages[slot].Voxels->SetName(names::Label);
+    data.LabelImages[slot].Voxels->SetNumberOfTuples(size);
+    data.LabelImages[slot].Labels.clear();
+  }
+  MeshData::LabelImage& image = data.LabelImages[slot];
+  if (!PatchVoxelLabels(data.Mesh, data.Cut.Owner, image.Labels, labels, image.Voxels->GetPointer(0), SMPParallelFor()))
+  {
+    VoxelLabels(data.Cut.Owner, labels, image.Voxels->GetPointer(0), SMPParallelFor());
+  }
+  image.Labels = labels;
+  data.LastLabelImage = slot;
+  return image.Voxels;
 }
 
 int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featuremesh::LabelledSeeds& seeds,

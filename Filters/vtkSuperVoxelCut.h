@@ -35,6 +35,7 @@ namespace featuremesh
 class LocalContrastArray;
 }
 class vtkUnstructuredGrid;
+class vtkUnsignedCharArray;
 // The filter is its Core parameters (TTK's shape): each energy property's value and default live in
 // featuremesh::SuperVoxelCutParameters and MultiLabelParameters, which the setters write.
 class FEATUREMESHFILTERS_EXPORT vtkSuperVoxelCut
@@ -133,6 +134,8 @@ protected:
 
 private:
   // The three outputs from the elements' labels and the boundary faces between them.
+  // Output 2's voxel labels, in an array the filter keeps for the next cut.
+  vtkUnsignedCharArray* LabelVoxels(const std::vector<std::uint8_t>& labels);
   void WriteLabels(vtkUnstructuredGrid* input, const std::vector<std::uint8_t>& labels,
     const std::vector<std::int64_t>& boundaryFaces, vtkInformationVector* outputVector);
   // Makes (or keeps, for a seed edit) the mesh-dependent data: -1 to go on, else RequestData's result.

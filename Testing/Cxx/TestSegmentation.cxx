@@ -416,6 +416,48 @@ TEST(SuperVoxelCut, BoundedVoxelValuesCutAsSortedOnes)
   }
 }
 
+TEST(SuperVoxelCut, PatchedVoxelLabelsEqualFreshOnes)
+{
+  // Off-lattice elements in 3D and 2D: the label image of one labelling, patched where a second
+  // differs, equals the second's own label image; a change over most of the image is refused.
+  for (const bool volume : { true, false })
+  {
+    ImageGeometry g;
+    g.Dims = { { 31, 27, volume ? 23 : 1 } };
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<std::array<double, 3>> pts;
+    for (int n = 0; n < (volume ? 600 : 150); ++n)
+      pts.push_back({ { u(rng) * 30, u(rng) * 26, volume ? u(rng) * 22 : 0.0 } });
+    for (int c = 0; c < (volume ? 8 : 4); ++c)
+      pts.push_back({ { (c & 1) ? 30.0 : 0, (c & 2) ? 26.0 : 0, (c & 4) ? 22.0 : 0 } });
+    SimplexMesh mesh;
+    ASSERT_TRUE(CGALMeshOfNodes(g, pts, mesh));
+    SuperVoxelCutData data;
+    std::string error;
+    ASSERT_TRUE(PrepareSuperVoxelCut(mesh, static_cast<const double*>(nullptr), data, error, SerialFor()));
+    const std::int64_t m = mesh.NumberOfElements();
+    std::vector<std::uint8_t> before(m), after;
+    for (auto& l : before)
+      l = static_cast<std::uint8_t>(u(rng) * 3);
+    after = before;
+    for (std::int64_t e = 0; e < m; e += m / 4) // boxes of four elements: a few thousand voxels
+      after[e] = static_cast<std::uint8_t>((after[e] + 1) % 3);
+    std::vector<std::uint8_t> patched(g.Size()), fresh(g.Size());
+    VoxelLabels(data.Owner, before, patched.data(), SerialFor());
+    VoxelLabels(data.Owner, after, fresh.data(), SerialFor());
+    ASSERT_NE(patched, fresh);
+    ASSERT_TRUE(PatchVoxelLabels(mesh, data.Owner, before, after, patched.data(), SerialFor()));
+    EXPECT_EQ(patched, fresh);
+    std::vector<std::uint8_t> flipped(after);
+    for (auto& l : flipped)
+      l = static_cast<std::uint8_t>((l + 1) % 3);
+    EXPECT_FALSE(PatchVoxelLabels(mesh, data.Owner, after, flipped, patched.data(), SerialFor()));
+    EXPECT_EQ(patched, fresh);
+    EXPECT_FALSE(PatchVoxelLabels(mesh, data.Owner, std::vector<std::uint8_t>(), after, patched.data(), SerialFor()));
+  }
+}
+
 TEST(SuperVoxelCut, ContactAndHardConstraintsOnFourTriangles)
 {
   // Anisotropic pixels: a spoke of length sqrt(2^2 0.5^2 + 2^2 1.5^2) counts in units of the mean

@@ -237,6 +237,77 @@ void VoxelLabels(const VoxelOwnerMap& owner, const std::vector<std::uint8_t>& la
   });
 }
 
+bool PatchVoxelLabels(const SimplexMesh& mesh, const VoxelOwnerMap& owner, const std::vector<std::uint8_t>& before,
+  const std::vector<std::uint8_t>& label, std::uint8_t* out, const ParallelFor& parallel)
+{
+  const std::int64_t m = mesh.NumberOfElements();
+  const ImageGeometry& g = mesh.Geometry();
+  if (static_cast<std::int64_t>(before.size()) != m || static_cast<std::int64_t>(label.size()) != m ||
+    static_cast<std::int64_t>(owner.size()) != g.Size())
+  {
+    return false;
+  }
+  // Each changed element's voxel box: the voxel centres its index-space bounds hold, one voxel of
+  // slack either side.
+  struct Box
+  {
+    std::int64_t Element;
+    std::array<int, 3> Low, High;
+  };
+  std::vector<Box> boxes;
+  std::int64_t scanned = 0;
+  const int vpc = mesh.VerticesPerCell();
+  for (std::int64_t e = 0; e < m; ++e)
+  {
+    if (before[e] == label[e])
+    {
+      continue;
+    }
+    Box b{ e, { { g.Dims[0], g.Dims[1], g.Dims[2] } }, { { -1, -1, -1 } } };
+    const std::int64_t* cell = mesh.Cell(e);
+    for (int c = 0; c < 3; ++c)
+    {
+      double lo = mesh.Points()[cell[0]][c], hi = lo;
+      for (int k = 1; k < vpc; ++k)
+      {
+        lo = std::min(lo, mesh.Points()[cell[k]][c]);
+        hi = std::max(hi, mesh.Points()[cell[k]][c]);
+      }
+      b.Low[c] = std::max(0, static_cast<int>(std::floor(lo)) - 1);
+      b.High[c] = std::min(g.Dims[c] - 1, static_cast<int>(std::ceil(hi)) + 1);
+    }
+    scanned += static_cast<std::int64_t>(b.High[0] - b.Low[0] + 1) * (b.High[1] - b.Low[1] + 1) * (b.High[2] - b.Low[2] + 1);
+    if (scanned > g.Size() / 4)
+    {
+      return false;
+    }
+    boxes.push_back(b);
+  }
+  // Elements own disjoint voxels: the writes of two elements never meet.
+  parallel(static_cast<std::int64_t>(boxes.size()), 256, [&](std::int64_t first, std::int64_t last) {
+    for (std::int64_t i = first; i < last; ++i)
+    {
+      const Box& b = boxes[i];
+      const std::int32_t e = static_cast<std::int32_t>(b.Element);
+      for (int z = b.Low[2]; z <= b.High[2]; ++z)
+      {
+        for (int y = b.Low[1]; y <= b.High[1]; ++y)
+        {
+          const std::int64_t row = g.Index(0, y, z);
+          for (int x = b.Low[0]; x <= b.High[0]; ++x)
+          {
+            if (owner[row + x] == e)
+            {
+              out[row + x] = label[b.Element];
+            }
+          }
+        }
+      }
+    }
+  });
+  return true;
+}
+
 std::string ValidateParameters(const SeededCutParameters& p)
 {
   std::string error = ValidateParameters(static_cast<const BoykovJollyParameters&>(p));

@@ -158,6 +158,13 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
 void VoxelLabels(const VoxelOwnerMap& owner, const std::vector<std::uint8_t>& label, std::uint8_t* out,
   const ParallelFor& parallel);
 
+// VoxelLabels by difference: `out` holds the voxel labels of `before`; the voxels of the elements
+// whose label differs in `label` are rewritten, each element's searched within its bounding box.
+// False, `out` untouched, when the labels' sizes differ or the boxes hold over a quarter of the image
+// (then VoxelLabels is cheaper).
+bool PatchVoxelLabels(const SimplexMesh& mesh, const VoxelOwnerMap& owner, const std::vector<std::uint8_t>& before,
+  const std::vector<std::uint8_t>& label, std::uint8_t* out, const ParallelFor& parallel);
+
 // The voxel cut on the 4-/6-connected grid, each neighbour pair one voxel face; `values` (one per
 // voxel) is moved in, not copied.
 CutResult VoxelCut(std::vector<double> values, const ImageGeometry& geometry,
