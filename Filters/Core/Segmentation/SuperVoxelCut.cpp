@@ -263,7 +263,7 @@ bool PatchVoxelLabels(const SimplexMesh& mesh, const VoxelOwnerMap& owner, const
     {
       continue;
     }
-    Box b{ e, { { g.Dims[0], g.Dims[1], g.Dims[2] } }, { { -1, -1, -1 } } };
+    Box b{ e, {}, {} };
     const std::int64_t* cell = mesh.Cell(e);
     for (int c = 0; c < 3; ++c)
     {
@@ -276,7 +276,12 @@ bool PatchVoxelLabels(const SimplexMesh& mesh, const VoxelOwnerMap& owner, const
       b.Low[c] = std::max(0, static_cast<int>(std::floor(lo)) - 1);
       b.High[c] = std::min(g.Dims[c] - 1, static_cast<int>(std::ceil(hi)) + 1);
     }
-    scanned += static_cast<std::int64_t>(b.High[0] - b.Low[0] + 1) * (b.High[1] - b.Low[1] + 1) * (b.High[2] - b.Low[2] + 1);
+    std::int64_t voxels = 1;
+    for (int c = 0; c < 3; ++c)
+    {
+      voxels *= std::max(0, b.High[c] - b.Low[c] + 1); // none for an element beside the image
+    }
+    scanned += voxels;
     if (scanned > g.Size() / 4)
     {
       return false;
