@@ -5,7 +5,8 @@
  * Input "Labelled Mesh": the Super-Voxel Cut's first output (triangles or tetrahedra with the cell
  * array Label, 0 background / 1..k objects, and the image frame in field data). Output 0: the boundary
  * between the labels (2D polylines, 3D triangles; one closed outward surface for one object) at its smoothed
- * positions: Laplacian (the thesis, 3 iterations of relaxation 0.5) or Taubin (no shrinkage).
+ * positions: Taubin (default, 10 iterations: no shrinkage) or Laplacian (the thesis: 3 iterations
+ * of relaxation 0.5).
  * Output 1: the labelled mesh whose nodes followed the boundary, every element positively oriented
  * and above its quality floor, labels unchanged, quality arrays recomputed and the stale image
  * statistics dropped; its boundary nodes are output 0's points. Point array Shortfall: how far a
@@ -40,10 +41,11 @@ public:
     LAPLACIAN = 0,
     TAUBIN = 1
   };
-  /// Laplacian (the thesis, default) or Taubin (lambda|mu: does not shrink).
+  /// Taubin (default; lambda|mu: does not shrink) or Laplacian (the thesis).
   virtual void SetMethod(int method);
   virtual int GetMethod();
-  /// Iterations (default 3, the thesis); Taubin's iteration is one lambda and one mu step.
+  /// Iterations (default 10; the thesis's Laplacian takes 3); Taubin's iteration is one lambda and
+  /// one mu step.
   vtkSetMacro(Iterations, int);
   vtkGetMacro(Iterations, int);
   /// Relaxation factor lambda (default 0.5, the thesis).

@@ -3,12 +3,13 @@
 usage: pvpython scripts/benchmark_surface.py [--cases a,b] [--runs 3] [--out out/benchmark_surface]
 For every 3D case with a truth (bundled Data/ and ../shared/data/cases), the main job's pipeline at
 its defaults (Feature Nodes -> Delaunay Image Mesh -> Image Mesh Smoothing -> Super-Voxel Cut), then
-the cut's boundary and Segmentation Surface Smoothing's at each method: Laplacian 3 (the thesis, the
-default), Taubin 3 and Taubin 10, each with the volume mesh (output 0 lies on the moved mesh) and
+the cut's boundary and Segmentation Surface Smoothing's at each method: Laplacian 3 (the thesis),
+Taubin 3, Taubin 10 (the default) and Laplacian 1, each with the volume mesh (output 0 lies on the moved mesh) and
 without it (the smoothed surface alone). Per row: the symmetric surface distance to the reference
 object's boundary (the 0.5 iso-surface of the truth; area-weighted both ways, mean and 95 %
 Hausdorff, world units; faces on the image box left out on both sides: the truth's iso-surface is
-open there and the box faces are planar by design), the object's volume change, the boundary nodes
+open there and the box faces are planar by design), the bending (metrics.bending: the mean angle
+between adjacent faces' normals, whole surface), the object's volume change, the boundary nodes
 short of their smoothed position and the share of the smoothing's displacement the mesh took, the
 smallest dihedral angle of the mesh, and the filter's seconds (median of --runs; the core's surface
 and volume-mesh seconds). Writes OUT.md and OUT.csv.
@@ -57,7 +58,7 @@ def main():
         def row(variant, surface, **extra):
             d = metrics.surface_distances(metrics.without_box_faces(surface, box), reference)
             r = {"case": name, "variant": variant, "dice": round(dice, 4), "faces": surface.GetNumberOfCells(),
-                 "mean_distance": round(d["mean"], 3), "hd95": round(d["hd95"], 3)}
+                 "mean_distance": round(d["mean"], 3), "hd95": round(d["hd95"], 3), "bending": round(metrics.bending(surface), 1)}
             r.update(extra)
             rows.append(r)
             print(r, flush=True)
@@ -84,7 +85,7 @@ def main():
                     volume_seconds=round(statistics.median(volume_s), 3))
                 ps.Delete(smooth)
     os.makedirs(os.path.dirname(args.out), exist_ok=True)
-    keys = ["case", "variant", "dice", "faces", "mean_distance", "hd95", "volume_change_pct", "short_nodes", "reached", "min_dihedral",
+    keys = ["case", "variant", "dice", "faces", "mean_distance", "hd95", "bending", "volume_change_pct", "short_nodes", "reached", "min_dihedral",
             "seconds", "surface_seconds", "volume_seconds"]
     with open(args.out + ".csv", "w", newline="") as f:
         w = csv.DictWriter(f, keys)

@@ -1,13 +1,14 @@
 """Digests of every stage's output on every case (pvpython): the check behind "same results".
 
 usage: pvpython scripts/digest.py [--cases a,b] [--out FILE] [--cut Lambda=1,Connectivity=0]
+                                 [--surface Method=0,Iterations=3]
 For each case (bundled Data/ and ../shared/data/cases) prints one line per output: the SHA-256 of
 the node points and arrays, of the mesh (points, cells, every cell array by value) and of its
 voxel -> element map, of the smoothed mesh (stage 3 at its defaults, default backend) and its map, of the
 super-voxel labels (cells and label image), of Segmentation Surface Smoothing's output (the labelled
 mesh's points and the boundary's faces), of the voxel cut's labels and of RSP Edge Enhancement's
 outputs with the seed-aware nodes made from them (one line, last per case, so older digests compare line for line), at the default
-properties (--cut overrides properties of both cuts, e.g. the defaults of an older commit); 3D cases
+properties (--cut overrides properties of both cuts, --surface of stage 6, e.g. the defaults of an older commit); 3D cases
 also with the CGAL backend. Without --cases, the multi-label cases follow (labels, then two kept
 re-cuts, each after a seed added where the result is most wrong). Compare two runs with diff.
 """
@@ -79,8 +80,10 @@ def main():
     ap.add_argument("--cases", default="")
     ap.add_argument("--out")
     ap.add_argument("--cut", default="", help="cut properties, e.g. Lambda=1,Connectivity=0")
+    ap.add_argument("--surface", default="", help="Segmentation Surface Smoothing properties, e.g. Method=0,Iterations=3")
     args = ap.parse_args()
-    cut_properties = {k: int(v) if v.isdigit() else float(v) for k, v in (p.split("=") for p in args.cut.split(",") if p)}
+    cut_properties, surface_properties = ({k: int(v) if v.isdigit() else float(v) for k, v in (p.split("=") for p in text.split(",") if p)}
+                                          for text in (args.cut, args.surface))
     fm.load_plugin()
     lines = []
     for name, d in fm.cases(args.cases).items():
@@ -99,7 +102,7 @@ def main():
             cut = case.super_voxel_cut(mesh, **cut_properties)
             lines.append("%s labels %s" % (tag, sha(fm.v2n(fm.fetch(cut, 0).GetCellData().GetArray(N.Label)),
                                                     fm.v2n(fm.fetch(cut, 2).GetPointData().GetScalars()))))
-            surface = case.surface_smoothing(cut)
+            surface = case.surface_smoothing(cut, **surface_properties)
             f0, f1 = fm.fetch(surface, 0), fm.fetch(surface, 1)
             faces = f0.GetPolys() if f0.GetNumberOfPolys() else f0.GetLines()
             lines.append("%s surface %s" % (tag, sha(fm.v2n(f1.GetPoints().GetData()), fm.v2n(faces.GetConnectivityArray()))))

@@ -5,7 +5,7 @@ usage: pvpython featuremesh_segment.py IMAGE (--object-seeds CSV --background-se
                                        [--truth LABELS] [--out DIR] [--plugin FeatureMesh.so]
                                        [--task object|class] [--lambda L] [--connectivity task|off|fill|seeded]
                                        [--intensity task|image|contrast] [--contrast-scale S] [--sigma S] [--bins B]
-                                       [--no-smoothing] [--rsp] [--surface-method laplacian|taubin]
+                                       [--no-smoothing] [--rsp] [--surface-method taubin|laplacian]
                                        [--surface-iterations N] [--unit mm]
 --rsp runs RSP Edge Enhancement first and feeds its edge map to Feature Nodes (seed-aware nodes: fine
 at the seeded object's boundary, coarse away from it; writes DIR/<name>_edge_confidence.vti too).
@@ -75,7 +75,8 @@ def main():
                     help="seed-aware nodes: RSP Edge Enhancement's edge map on Feature Nodes' Edge Map input")
     surface = ap.add_argument_group("Segmentation Surface Smoothing (default: the filter's own defaults)")
     surface.add_argument("--surface-method", choices=sorted(SURFACE_METHOD),
-                         help="laplacian (the thesis; shrinks) or taubin (keeps the volume)")
+                         help="taubin (the default, 10 iterations; keeps the volume) or laplacian (the thesis "
+                              "with --surface-iterations 3; shrinks)")
     surface.add_argument("--surface-iterations", type=int, help="smoothing iterations (property Iterations)")
     ap.add_argument("--unit", default="mm", help="the image spacing's unit, written where a format has a place for it "
                                                   "(MetaImage and NRRD do not record it; default mm)")

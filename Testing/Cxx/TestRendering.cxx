@@ -317,7 +317,7 @@ int main(int argc, char* argv[])
   }
   else if (scene == "LiverSurfaceSmoothing")
   {
-    // The cut's boundary (left) and Segmentation Surface Smoothing's (right, the defaults: Laplacian,
+    // The cut's boundary (left) and Segmentation Surface Smoothing's (right, the defaults: Taubin 10,
     // the labelled mesh moved with it), on the image-smoothed mesh as the main job runs it.
     vtkRenderer* right = SideBySide(win, ren);
     vtkAlgorithmOutput* boundaries[2] = { smoothedCut->GetOutputPort(1), surface->GetOutputPort(0) };

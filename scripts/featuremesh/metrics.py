@@ -314,3 +314,24 @@ def without_box_faces(surface, bounds, tolerance=1e-6):
     out.SetPoints(surface.GetPoints())
     out.SetPolys(cells)
     return out
+
+
+def bending(surface):
+    """Mean angle (degrees) between the normals of two triangles of `surface` sharing an edge, over
+    the edges in exactly two triangles: 0 for a plane, large for a staircase of element faces."""
+    P = v2n(surface.GetPoints().GetData()).astype(float)
+    F = v2n(surface.GetPolys().GetConnectivityArray()).reshape(-1, 3)
+    n = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    face = np.tile(np.arange(len(F)), 3)
+    order = np.lexsort((edges[:, 1], edges[:, 0]))
+    edges, face = edges[order], face[order]
+    same = (edges[1:] == edges[:-1]).all(axis=1)
+    # Edges in exactly two faces: equal to the next, and neither to the one before nor after the pair.
+    before = np.r_[False, same[:-1]]
+    after = np.r_[same[1:], False]
+    pair = same & ~before & ~after
+    a, b = face[:-1][pair], face[1:][pair]
+    cosines = np.clip(np.einsum("ij,ij->i", n[a], n[b]), -1.0, 1.0)
+    return float(np.degrees(np.arccos(cosines)).mean()) if len(a) else float("nan")
