@@ -134,10 +134,10 @@ protected:
 
 private:
   // The three outputs from the elements' labels and the boundary faces between them.
-  // Output 2's voxel labels, in an array the filter keeps for the next cut.
-  vtkUnsignedCharArray* LabelVoxels(const std::vector<std::uint8_t>& labels);
   void WriteLabels(vtkUnstructuredGrid* input, const std::vector<std::uint8_t>& labels,
     const std::vector<std::int64_t>& boundaryFaces, vtkInformationVector* outputVector);
+  // Output 2's voxel labels, in an array the filter keeps for the next cut.
+  vtkUnsignedCharArray* LabelVoxels(const std::vector<std::uint8_t>& labels);
   // Makes (or keeps, for a seed edit) the mesh-dependent data: -1 to go on, else RequestData's result.
   // With `voxelMeans` the elements' intensities are the means of `binaryValues` over their voxels
   // (the local contrast), not the mesh's MeanIntensity.

@@ -2,8 +2,8 @@
 oriented, unless the cut's own boundary pinches there) and lies on the labelled mesh's points; the
 labelled mesh keeps its labels and element count, no element inverts or falls below its quality
 floor, box nodes stay on their box faces; Laplacian shrinks and says so, Taubin keeps the volume;
-in 3D the surface moves at most half a voxel further from the truth on average; same output across
-runs and thread counts; bad input."""
+in 3D the surface bends less and moves at most half a voxel further from the truth on average; same
+output across runs and thread counts; bad input."""
 import os
 import sys
 
@@ -132,14 +132,18 @@ for name in CASES:
             ft.check(b["mean"] <= a["mean"] + 0.5 * spacing,
                      "%s: at most half a voxel further from the truth on average (mean %.2f -> %.2f, HD95 %.2f -> %.2f)"
                      % (what, a["mean"], b["mean"], a["hd95"], b["hd95"]))
+            # What smoothing is for: adjacent faces bend less (measured 38.8 -> 22.8 / 23.2 degrees on
+            # the liver, 47.9 -> 24.5 / 25.4 and 49.7 -> 25.3 / 27.0 on BraTS; Laplacian 3 / Taubin 10).
+            bent, smoothed = metrics.bending(boundary), metrics.bending(surface)
+            ft.check(smoothed < 0.75 * bent, "%s: adjacent faces bend less (%.1f -> %.1f degrees)" % (what, bent, smoothed))
         digests[method] = ft.digest(P)
-    s = case.surface_smoothing(cut)
+    s = case.surface_smoothing(cut)  # the defaults, Taubin 10: the loop's second run again
     s.UpdatePipeline()
-    ft.check(ft.digest(ft.v2n(ft.fetch(s, 1).GetPoints().GetData())) == digests[0], "%s: identical across runs" % name)
+    ft.check(ft.digest(ft.v2n(ft.fetch(s, 1).GetPoints().GetData())) == digests[1], "%s: identical across runs" % name)
     if name == "liver-ct-totalseg":
         one = ft.run_script_with_backend(__file__, "Sequential", name)
         two = ft.run_script_with_backend(__file__, "STDThread", name)
-        ft.check(one == two == digests[0], "%s: identical with 1 and 2 threads" % name)
+        ft.check(one == two == digests[1], "%s: identical with 1 and 2 threads" % name)
     # The surface alone (Volume Mesh off) is the plain smoothing: no node short, the mesh untouched.
     s = case.surface_smoothing(cut, VolumeMesh=0)
     s.UpdatePipeline()
