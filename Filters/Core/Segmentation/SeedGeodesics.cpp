@@ -299,18 +299,18 @@ struct SeedGeodesicCache::Kept
   GraphEdges Edges;
   std::vector<double> Value, Step;
   double Scale = 0.0, LengthWeight = 0.0;
-  std::unique_ptr<Adjacency> Neighbours;
+  // Depends on the graph alone: kept across a change of scale or length weight.
+  std::shared_ptr<const Adjacency> Neighbours;
   // Per seed kind (index kind - 1).
   std::vector<std::vector<std::int64_t>> Seeds;
   std::vector<DistanceField> Field;
 
-  bool Matches(const GeodesicGraph& g, double scale, double lengthWeight) const
+  bool SameGraph(const GeodesicGraph& g) const
   {
     const std::vector<double> none;
     const std::vector<double>& step = g.Step ? *g.Step : none;
-    return this->Scale == scale && this->LengthWeight == lengthWeight && this->Edges.Same(*g.Edges) &&
-      static_cast<std::int64_t>(this->Value.size()) == g.Nodes && std::equal(this->Value.begin(), this->Value.end(), g.Value) &&
-      this->Step == step;
+    return this->Edges.Same(*g.Edges) && static_cast<std::int64_t>(this->Value.size()) == g.Nodes &&
+      std::equal(this->Value.begin(), this->Value.end(), g.Value) && this->Step == step;
   }
 };
 
@@ -344,10 +344,14 @@ std::shared_ptr<SeedGeodesicCache::Kept> SeedGeodesicCache::Take(const GeodesicG
   int kinds, SeedGeodesicCache* cache)
 {
   std::shared_ptr<SeedGeodesicCache::Kept> kept = cache ? cache->State : nullptr;
-  if (!kept || !kept->Matches(graph, scale, lengthWeight))
+  const bool sameGraph = kept && kept->SameGraph(graph);
+  if (!sameGraph || kept->Scale != scale || kept->LengthWeight != lengthWeight)
   {
+    // A new range (a seed sample beyond it moves it) recomputes the distances, not the adjacency.
+    std::shared_ptr<const Adjacency> neighbours =
+      sameGraph ? kept->Neighbours : std::make_shared<const Adjacency>(*graph.Edges, graph.Nodes, graph.Step);
     kept = std::make_shared<SeedGeodesicCache::Kept>();
-    kept->Neighbours.reset(new Adjacency(*graph.Edges, graph.Nodes, graph.Step));
+    kept->Neighbours = std::move(neighbours);
     if (cache)
     {
       kept->Edges = graph.Edges->Keepable();
