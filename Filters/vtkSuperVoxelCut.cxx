@@ -372,13 +372,13 @@ vtkUnsignedCharArray* vtkSuperVoxelCut::LabelVoxels(const std::vector<std::uint8
   using namespace featuremesh;
   MeshData& data = *this->Prepared;
   const std::int64_t size = data.Mesh.Geometry().Size();
-  auto free = [&](int slot) {
+  auto unheld = [&](int slot) {
     const auto& voxels = data.LabelImages[slot].Voxels;
     return voxels && voxels->GetReferenceCount() == 1 && voxels->GetNumberOfTuples() == size;
   };
   // The last cut's image when no one holds it (the fewest changes), else the one before.
   const int last = data.LastLabelImage;
-  int slot = free(last) ? last : free(1 - last) ? 1 - last : -1;
+  int slot = unheld(last) ? last : unheld(1 - last) ? 1 - last : -1;
   if (slot < 0)
   {
     slot = 1 - last; // both held elsewhere, or none yet: a new array

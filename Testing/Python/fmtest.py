@@ -126,10 +126,13 @@ def check(condition, message):
     return True
 
 
-def finish():
+def finish(what=None):
+    """Exits 1 after listing the failed checks; else, with `what`, says that all of them passed."""
     if FAILURES:
         print("%d check(s) failed:\n  %s" % (len(FAILURES), "\n  ".join(FAILURES)), flush=True)
         os._exit(1)
+    if what:
+        print("all %s checks passed" % what, flush=True)
 
 
 atexit.register(finish)

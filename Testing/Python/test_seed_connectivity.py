@@ -64,5 +64,4 @@ for name in ("SuperVoxelCut", "VoxelCut"):
     volumes = results[1][2]
     ft.check(len(volumes) == 2 and abs(volumes.sum() - fill.sum()) < 1e-9 and volumes[0] >= volumes[1],
              "%s: ObjectComponentVolumes sum to the object area, largest first (%s)" % (name, volumes))
-ft.finish()  # exits on a failure, so the line below is true
-print("all seed-connectivity checks passed")
+ft.finish("seed-connectivity")
