@@ -106,7 +106,8 @@ int vtkDelaunayImageMesh::RequestData(
 
     double statisticsSeconds = this->Seconds();
     const ParallelFor parallel = SMPParallelFor();
-    const SimplexMesh mesh(geometry, std::move(index), std::move(delaunay.Cells), delaunay.VerticesPerCell);
+    SimplexMesh mesh(geometry, std::move(index), std::move(delaunay.Cells), delaunay.VerticesPerCell);
+    mesh.SortElementsSpatially();
     const vtkSmartPointer<vtkIntArray> owner = NewVoxelOwnerArray(outputVector, geometry.Size());
     const ElementStatistics stats = ImageElementStatistics(ElementRasterizer(mesh), values, parallel,
       AlgorithmProgress(this, 0.5, 0.9), owner ? owner->GetPointer(0) : nullptr);

@@ -273,6 +273,51 @@ TEST(SimplexMesh, AdjacencyOfFourTriangles)
   EXPECT_FALSE(SimplexMesh(mesh.Geometry(), mesh.Points(), { 0, 1, 7 }, 3).Validate().empty());
 }
 
+// Stages 2 and 3 write their elements in SpatialElementOrder: the same elements, renumbered so that
+// face neighbours are near in the numbering (the mesher's numbering scatters them).
+TEST(SimplexMesh, SortElementsSpatiallyKeepsTheElementsAndGathersNeighbours)
+{
+  ImageGeometry g;
+  g.Dims = { { 40, 36, 32 } };
+  std::mt19937 rng(11);
+  std::vector<std::array<double, 3>> pts;
+  for (int c = 0; c < 8; ++c)
+    pts.push_back({ { (c & 1) ? g.Dims[0] - 1.0 : 0, (c & 2) ? g.Dims[1] - 1.0 : 0, (c & 4) ? g.Dims[2] - 1.0 : 0 } });
+  for (int t = 0; t < 4000; ++t)
+    pts.push_back({ { double(rng() % g.Dims[0]), double(rng() % g.Dims[1]), double(rng() % g.Dims[2]) } });
+  std::sort(pts.begin(), pts.end());
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  const DelaunayResult delaunay = Tetrahedralize(pts, DelaunayImageMeshParameters());
+  ASSERT_TRUE(delaunay.Error.empty()) << delaunay.Error;
+  const SimplexMesh mesher(g, delaunay.Points, delaunay.Cells, delaunay.VerticesPerCell);
+  SimplexMesh sorted = mesher;
+  const FaceAdjacency& before = mesher.Faces(); // cached, then dropped by the sort
+  sorted.SortElementsSpatially();
+  ASSERT_EQ(sorted.NumberOfElements(), mesher.NumberOfElements());
+  const auto rows = [](const SimplexMesh& m) {
+    std::vector<std::array<std::int64_t, 4>> r(m.NumberOfElements());
+    for (std::int64_t e = 0; e < m.NumberOfElements(); ++e)
+      std::copy_n(m.Cell(e), 4, r[e].begin());
+    std::sort(r.begin(), r.end());
+    return r;
+  };
+  EXPECT_EQ(rows(sorted), rows(mesher)); // the same elements, each with its vertex order
+  const std::vector<std::int64_t> order = SpatialElementOrder(sorted);
+  for (std::int64_t e = 0; e < sorted.NumberOfElements(); ++e)
+    ASSERT_EQ(order[e], e) << "sorting twice changes nothing";
+  const auto medianGap = [](const FaceAdjacency& f) {
+    std::vector<std::int64_t> gap(f.A.size());
+    for (size_t i = 0; i < gap.size(); ++i)
+      gap[i] = f.B[i] - f.A[i];
+    std::nth_element(gap.begin(), gap.begin() + gap.size() / 2, gap.end());
+    return gap[gap.size() / 2];
+  };
+  const FaceAdjacency& after = sorted.Faces();
+  EXPECT_EQ(after.A.size(), before.A.size());
+  EXPECT_LT(medianGap(after), 16) << "face neighbours near in the numbering";
+  EXPECT_GT(medianGap(before), 4 * medianGap(after)) << "the mesher's numbering, for comparison";
+}
+
 // The label boundary of a tetrahedral mesh is closed (every edge in two faces, with opposite
 // directions) and outward (it encloses the labelled volume, positively); a mirrored frame flips
 // the faces so that they stay outward in world coordinates.

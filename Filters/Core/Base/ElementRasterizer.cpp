@@ -17,49 +17,7 @@ ElementRasterizer::ElementRasterizer(const SimplexMesh& mesh)
   // 3 * 2^37, row values below 2^41: all exact in double.
   const auto& d = mesh.Geometry().Dims;
   this->ExactBounds = d[0] < 4096 && d[1] < 4096 && d[2] < 4096;
-  // Morton keys of 10 bits per axis (blocks of at least 4 voxels) above 32 bits of element id:
-  // one 64-bit sort.
-  const std::int64_t m = mesh.NumberOfElements();
-  int shift = 2;
-  while ((std::max({ d[0], d[1], d[2] }) >> shift) >= 1024)
-  {
-    ++shift;
-  }
-  auto spread = [](std::uint64_t x) {
-    x &= 0x3ff;
-    x = (x | (x << 16)) & 0x30000ff;
-    x = (x | (x << 8)) & 0x300f00f;
-    x = (x | (x << 4)) & 0x30c30c3;
-    return (x | (x << 2)) & 0x9249249;
-  };
-  const auto& P = mesh.Points();
-  const int vpc = mesh.VerticesPerCell();
-  std::vector<std::uint64_t> key(static_cast<std::size_t>(m));
-  for (std::int64_t e = 0; e < m; ++e)
-  {
-    const std::int64_t* cell = mesh.Cell(e);
-    double lo[3] = { P[cell[0]][0], P[cell[0]][1], P[cell[0]][2] };
-    for (int v = 1; v < vpc; ++v)
-    {
-      for (int a = 0; a < 3; ++a)
-      {
-        lo[a] = std::min(lo[a], P[cell[v]][a]);
-      }
-    }
-    std::uint64_t code = 0;
-    for (int a = 0; a < 3; ++a)
-    {
-      const auto block = static_cast<std::uint64_t>(std::max(0.0, std::ceil(lo[a]))) >> shift;
-      code |= spread(block) << a;
-    }
-    key[e] = (code << 32) | static_cast<std::uint64_t>(e);
-  }
-  std::sort(key.begin(), key.end());
-  this->Order.resize(static_cast<std::size_t>(m));
-  for (std::int64_t i = 0; i < m; ++i)
-  {
-    this->Order[i] = static_cast<std::int64_t>(key[i] & 0xffffffffu);
-  }
+  this->Order = SpatialElementOrder(mesh);
 }
 
 template <typename T>

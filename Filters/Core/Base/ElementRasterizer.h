@@ -50,9 +50,9 @@ public:
     });
   }
 
-  // The elements in Morton order of their lowest voxel corner (4-voxel blocks): a pass over them
-  // in this order reads and writes neighbouring voxels, where mesher order jumps across the image
-  // and waits on memory. What a pass gives each element does not depend on the order.
+  // The elements in SpatialElementOrder (SimplexMesh.h): a pass over them in this order reads and
+  // writes neighbouring voxels, where mesher order jumps across the image and waits on memory. What
+  // a pass gives each element does not depend on the order.
   const std::vector<std::int64_t>& SpatialOrder() const { return this->Order; }
 
 private:

@@ -238,6 +238,86 @@ void SimplexMesh::SetPoints(std::vector<std::array<double, 3>> indexPoints)
   this->Cached = fresh;
 }
 
+void SimplexMesh::SortElementsSpatially()
+{
+  // In place, cycle by cycle (element i takes the cells of order[i]): no second copy of the cells,
+  // 134 MB at 512^3.
+  const std::vector<std::int64_t> order = SpatialElementOrder(*this);
+  const int vpc = this->Vpc;
+  std::vector<bool> placed(order.size(), false);
+  for (std::size_t start = 0; start < order.size(); ++start)
+  {
+    if (placed[start] || order[start] == static_cast<std::int64_t>(start))
+    {
+      continue;
+    }
+    std::array<std::int64_t, 4> first{};
+    std::copy_n(this->CellIds.data() + start * vpc, vpc, first.begin());
+    std::size_t i = start;
+    for (;;)
+    {
+      placed[i] = true;
+      const auto from = static_cast<std::size_t>(order[i]);
+      if (from == start)
+      {
+        std::copy_n(first.begin(), vpc, this->CellIds.data() + i * vpc);
+        break;
+      }
+      std::copy_n(this->CellIds.data() + from * vpc, vpc, this->CellIds.data() + i * vpc);
+      i = from;
+    }
+  }
+  this->Cached = std::make_shared<Cache>();
+}
+
+std::vector<std::int64_t> SpatialElementOrder(const SimplexMesh& mesh)
+{
+  // Morton keys above 32 bits of element id: one 64-bit sort.
+  const auto& d = mesh.Geometry().Dims;
+  const std::int64_t m = mesh.NumberOfElements();
+  int shift = 2;
+  while ((std::max({ d[0], d[1], d[2] }) >> shift) >= 1024)
+  {
+    ++shift;
+  }
+  auto spread = [](std::uint64_t x) {
+    x &= 0x3ff;
+    x = (x | (x << 16)) & 0x30000ff;
+    x = (x | (x << 8)) & 0x300f00f;
+    x = (x | (x << 4)) & 0x30c30c3;
+    return (x | (x << 2)) & 0x9249249;
+  };
+  const auto& P = mesh.Points();
+  const int vpc = mesh.VerticesPerCell();
+  std::vector<std::uint64_t> key(static_cast<std::size_t>(m));
+  for (std::int64_t e = 0; e < m; ++e)
+  {
+    const std::int64_t* cell = mesh.Cell(e);
+    double lo[3] = { P[cell[0]][0], P[cell[0]][1], P[cell[0]][2] };
+    for (int v = 1; v < vpc; ++v)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        lo[a] = std::min(lo[a], P[cell[v]][a]);
+      }
+    }
+    std::uint64_t code = 0;
+    for (int a = 0; a < 3; ++a)
+    {
+      const auto block = static_cast<std::uint64_t>(std::max(0.0, std::ceil(lo[a]))) >> shift;
+      code |= spread(block) << a;
+    }
+    key[e] = (code << 32) | static_cast<std::uint64_t>(e);
+  }
+  std::sort(key.begin(), key.end());
+  std::vector<std::int64_t> order(static_cast<std::size_t>(m));
+  for (std::int64_t i = 0; i < m; ++i)
+  {
+    order[i] = static_cast<std::int64_t>(key[i] & 0xffffffffu);
+  }
+  return order;
+}
+
 const FaceAdjacency& SimplexMesh::Faces() const
 {
   std::lock_guard<std::mutex> lock(this->Cached->Lock);

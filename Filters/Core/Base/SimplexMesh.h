@@ -65,6 +65,11 @@ public:
   // Replaces the points (same count; stage 3 moves them), dropping the face measures.
   void SetPoints(std::vector<std::array<double, 3>> indexPoints);
 
+  // Renumbers the elements in SpatialElementOrder, dropping the cached adjacency. Stages 2 and 3
+  // write their meshes so: a pass over the elements' neighbours (the cut's Dijkstra and max-flow)
+  // then finds them near in memory, where the meshers' order scatters them.
+  void SortElementsSpatially();
+
   // Built on first use, then cached; safe to call from several threads.
   const FaceAdjacency& Faces() const;
   // The same adjacency, shared: it stays alive (unchanged) as long as a holder keeps it.
@@ -85,6 +90,10 @@ private:
   };
   std::shared_ptr<Cache> Cached = std::make_shared<Cache>();
 };
+
+// The elements in Morton order of their lowest voxel corner (blocks of 4 voxels or more, 10 bits
+// per axis), ties in id order. Elements near in the image are then near in the order.
+std::vector<std::int64_t> SpatialElementOrder(const SimplexMesh& mesh);
 
 // Signed area (triangles, xy) or volume (tetrahedra) of the simplex with vertices v[0..vpc): the
 // one formula of the project (orientation, ODT weights, a label's measure).

@@ -1146,6 +1146,7 @@ ImageMeshSmoothingResult SmoothImageMesh(const SimplexMesh& mesh, const std::vec
     s.Points = swept;
   }
   result.Mesh = std::move(s.Topology);
+  result.Mesh.SortElementsSpatially();
   return result;
 }
 } // namespace featuremesh
