@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace featuremesh
 {
@@ -17,7 +18,15 @@ ElementRasterizer::ElementRasterizer(const SimplexMesh& mesh)
   // 3 * 2^37, row values below 2^41: all exact in double.
   const auto& d = mesh.Geometry().Dims;
   this->ExactBounds = d[0] < 4096 && d[1] < 4096 && d[2] < 4096;
-  this->Order = SpatialElementOrder(mesh);
+  if (mesh.InSpatialOrder())
+  {
+    this->Order.resize(static_cast<std::size_t>(mesh.NumberOfElements()));
+    std::iota(this->Order.begin(), this->Order.end(), std::int64_t(0));
+  }
+  else
+  {
+    this->Order = SpatialElementOrder(mesh);
+  }
 }
 
 template <typename T>

@@ -227,6 +227,7 @@ void SimplexMesh::OrientPositively()
 void SimplexMesh::SetPoints(std::vector<std::array<double, 3>> indexPoints)
 {
   this->IndexPoints = std::move(indexPoints);
+  this->SpatiallySorted = false;
   // Topology caches stay valid; face measures do not. A fresh cache keeps copies that share the
   // old one unaffected.
   auto fresh = std::make_shared<Cache>();
@@ -267,6 +268,7 @@ void SimplexMesh::SortElementsSpatially()
       i = from;
     }
   }
+  this->SpatiallySorted = true;
   this->Cached = std::make_shared<Cache>();
 }
 

@@ -69,6 +69,9 @@ public:
   // write their meshes so: a pass over the elements' neighbours (the cut's Dijkstra and max-flow)
   // then finds them near in memory, where the meshers' order scatters them.
   void SortElementsSpatially();
+  // Whether the elements are in SpatialElementOrder as sorted (moving the points forgets it): the
+  // rasteriser then walks them as they are instead of sorting them again.
+  bool InSpatialOrder() const { return this->SpatiallySorted; }
 
   // Built on first use, then cached; safe to call from several threads.
   const FaceAdjacency& Faces() const;
@@ -82,6 +85,7 @@ private:
   std::vector<std::array<double, 3>> IndexPoints;
   std::vector<std::int64_t> CellIds;
   int Vpc = 0;
+  bool SpatiallySorted = false;
   struct Cache
   {
     std::mutex Lock;
