@@ -38,7 +38,7 @@ struct vtkSuperVoxelCut::MeshData
   std::vector<std::pair<vtkObject*, vtkMTimeType>> Sources;
   featuremesh::ImageGeometry Frame;
   featuremesh::SimplexMesh Mesh;
-  std::vector<double> Mean, Count;
+  featuremesh::SharedArray<double> Mean, Count; // shared with the cut's problem and its caches
   featuremesh::SuperVoxelCutData Cut;
   featuremesh::MaxFlowCache Flow;
   // For labelled seeds, made when first asked for: the voxels' channel bins, each element's runs of
@@ -272,13 +272,15 @@ int vtkSuperVoxelCut::Prepare(vtkUnstructuredGrid* input, const featuremesh::Ima
     return this->Fail(error);
   }
   const vtkIdType nCells = input->GetNumberOfCells();
-  prepared->Mean.resize(nCells);
-  prepared->Count.resize(nCells);
+  std::vector<double>& means = prepared->Mean.Mutable();
+  std::vector<double>& counts = prepared->Count.Mutable();
+  means.resize(nCells);
+  counts.resize(nCells);
   vtkIdType badMean = 0, badCount = 0;
   for (vtkIdType c = 0; c < nCells; ++c)
   {
-    const double mean = prepared->Mean[c] = meanArray->GetComponent(c, 0);
-    const double count = prepared->Count[c] = countArray->GetComponent(c, 0);
+    const double mean = means[c] = meanArray->GetComponent(c, 0);
+    const double count = counts[c] = countArray->GetComponent(c, 0);
     badMean += std::isfinite(mean) ? 0 : 1;
     badCount += std::isfinite(count) && count >= 0 ? 0 : 1;
   }

@@ -699,8 +699,7 @@ TEST(MultiLabel, KeptDistancesOfEveryLabelEqualFreshOnes)
   const GraphEdges edges = GraphEdges::Grid(40, 30, 1);
   GeodesicGraph graph;
   graph.Edges = &edges;
-  graph.Value = value.data();
-  graph.Nodes = g.Size();
+  graph.Value = value;
   std::vector<std::uint8_t> hard(g.Size(), 0);
   hard[g.Index(3, 3, 0)] = 1;
   hard[g.Index(30, 20, 0)] = 2;

@@ -34,14 +34,14 @@ CutProblem SeededChain(const std::vector<double>& values)
   std::vector<std::int64_t> A, B;
   for (std::int64_t i = 0; i < n; ++i)
   {
-    pr.Value.push_back(values[i]);
-    pr.Size.push_back(1.0);
+    pr.Value.Mutable().push_back(values[i]);
+    pr.Size.Mutable().push_back(1.0);
     pr.Hard.push_back(i == 0 ? 1 : (i == n - 1 ? 2 : 0));
     if (i > 0)
     {
       A.push_back(i - 1);
       B.push_back(i);
-      pr.Contact.push_back(1.0);
+      pr.Contact.Mutable().push_back(1.0);
     }
   }
   pr.Edges = GraphEdges::Owned(std::move(A), std::move(B));
@@ -237,7 +237,8 @@ TEST(BoykovJolly, VoxelRegionTermCountsEveryVoxelInItsBin)
   }
   CutProblem pr = SeededChain(mean);
   pr.Size = count;
-  std::fill(pr.Contact.begin(), pr.Contact.end(), 0.0);
+  std::vector<double>& contact = pr.Contact.Mutable();
+  std::fill(contact.begin(), contact.end(), 0.0);
   pr.ObjectSamples = { 28, 30, 33, 31, 26 };
   pr.BackgroundSamples = { 8, 12, 10, 9, 14 };
   const std::vector<std::pair<std::int64_t, int>> forms = { { SortedVoxelLimit, 64 }, { SortedVoxelLimit, 100 }, { 0, 64 }, { 0, 100 } };
@@ -514,16 +515,16 @@ TEST(Guards, EnergyInputsAreCheckedAndSeedsAlwaysHold)
   EXPECT_EQ(r.Label.back(), 0);
   // Non-finite or too large intensities, negative sizes and contacts are errors.
   CutProblem bad = pr;
-  bad.Value[2] = std::nan("");
+  bad.Value.Mutable()[2] = std::nan("");
   EXPECT_NE(BoykovJollyCut(bad, BoykovJollyParameters()).Error.find("NaN"), std::string::npos);
   bad = pr;
-  bad.Value[2] = 1e300;
+  bad.Value.Mutable()[2] = 1e300;
   EXPECT_FALSE(BoykovJollyCut(bad, BoykovJollyParameters()).Error.empty());
   bad = pr;
-  bad.Size[1] = -1;
+  bad.Size.Mutable()[1] = -1;
   EXPECT_FALSE(BoykovJollyCut(bad, BoykovJollyParameters()).Error.empty());
   bad = pr;
-  bad.Contact[0] = std::numeric_limits<double>::infinity();
+  bad.Contact.Mutable()[0] = std::numeric_limits<double>::infinity();
   EXPECT_FALSE(BoykovJollyCut(bad, BoykovJollyParameters()).Error.empty());
   bad = pr;
   std::vector<std::int64_t> A(pr.Edges.First(), pr.Edges.First() + pr.Edges.Size());
@@ -871,9 +872,8 @@ TEST(SeedGeodesics, KeptDistancesEqualFreshOnes)
   const GraphEdges edges(a, b);
   GeodesicGraph graph;
   graph.Edges = &edges;
-  graph.Value = value.data();
-  graph.Nodes = g.Size();
-  graph.Step = &step;
+  graph.Value = value;
+  graph.Step = step;
   const std::vector<std::vector<std::int64_t>> object = { { g.Index(15, 15, 0) }, { g.Index(15, 15, 0), g.Index(12, 18, 0) },
     { g.Index(12, 18, 0) }, { g.Index(13, 18, 0) }, { g.Index(13, 18, 0), g.Index(18, 12, 0) }, { g.Index(13, 18, 0), g.Index(18, 12, 0) },
     { g.Index(16, 16, 0) } };
@@ -932,9 +932,8 @@ TEST(SeedGeodesics, DijkstraMatchesBellmanFord)
   const GraphEdges edges(a, b);
   GeodesicGraph graph;
   graph.Edges = &edges;
-  graph.Value = value.data();
-  graph.Nodes = n;
-  graph.Step = &step;
+  graph.Value = value;
+  graph.Step = step;
   std::vector<std::uint8_t> hard(n, 0);
   for (int s = 0; s < 6; ++s)
     hard[rng() % n] = 1;
@@ -974,9 +973,8 @@ TEST(SeedGeodesics, DistancesAddTheStepsAndTheLength)
   const std::vector<double> value = { 0, 0, 10, 10 }, step = { 1, 2, 1 };
   GeodesicGraph graph;
   graph.Edges = &edges;
-  graph.Value = value.data();
-  graph.Nodes = 4;
-  graph.Step = &step;
+  graph.Value = value;
+  graph.Step = step;
   const std::vector<std::uint8_t> hard = { 1, 0, 0, 2 };
   const std::vector<double> d = GeodesicDistances(graph, hard, 1, 10.0, 0.1);
   ASSERT_EQ(d.size(), 4u);

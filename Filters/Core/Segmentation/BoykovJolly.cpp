@@ -499,9 +499,10 @@ using Flow = maxflow::Graph_DDD;
 struct MaxFlowCache::Kept
 {
   std::shared_ptr<Flow> Graph;
-  // The boundary term's inputs (explicit edge lists copied) and what it made of them.
+  // The boundary term's inputs (explicit edge lists copied unless held; the arrays shared) and
+  // what it made of them.
   GraphEdges Edges;
-  std::vector<double> Value, Contact;
+  SharedArray<double> Value, Contact;
   double SigmaParameter = 0.0, Sigma = 0.0, WeightTotal = 0.0;
   std::unique_ptr<double[]> Weight; // one per edge
   // The terminal capacities of the last flow.
@@ -920,9 +921,8 @@ bool AddSeedGeodesicTerm(const CutProblem& pr, double range, SeedGeodesicCache* 
   const auto t0 = Clock::now();
   GeodesicGraph graph;
   graph.Edges = &pr.Edges;
-  graph.Value = pr.Value.data();
-  graph.Nodes = static_cast<std::int64_t>(pr.Value.size());
-  graph.Step = &pr.Step;
+  graph.Value = pr.Value;
+  graph.Step = pr.Step;
   std::vector<double> spatialObject, spatialBackground;
   if (!SeedGeodesicCosts(graph, pr.Hard, range, pr.Geodesic, pr.Parallel, spatialObject, spatialBackground, progress, kept))
   {

@@ -15,6 +15,7 @@
 #include "GraphEdges.h"
 #include "Parallel.h"
 #include "SeedGeodesics.h"
+#include "SharedArray.h"
 
 #include <cstdint>
 #include <memory>
@@ -93,10 +94,11 @@ std::vector<double> NodeMeans(const NodeVoxelValues& grouped);
 
 struct CutProblem
 {
-  std::vector<double> Value;   // intensity of each node (mean intensity for an element)
-  std::vector<double> Size;    // region-term weight of each node (its voxel count); empty = 1 each
-  GraphEdges Edges;             // explicit lists (viewed, held or owned) or a voxel grid
-  std::vector<double> Contact; // per edge, in voxel faces; empty = 1 each (the voxel grid)
+  // The arrays are shared, not copied, by the records a MaxFlowCache keeps.
+  SharedArray<double> Value;   // intensity of each node (mean intensity for an element)
+  SharedArray<double> Size;    // region-term weight of each node (its voxel count); empty = 1 each
+  GraphEdges Edges;            // explicit lists (viewed, held or owned) or a voxel grid
+  SharedArray<double> Contact; // per edge, in voxel faces; empty = 1 each (the voxel grid)
   std::vector<std::uint8_t> Hard; // 0 free, 1 object seed, 2 background seed
   std::vector<double> ObjectSamples, ObjectWeights, BackgroundSamples, BackgroundWeights;
   // Optional exact region term for super-voxels (not owned): node p's region cost becomes the sum
@@ -106,7 +108,7 @@ struct CutProblem
   // The seeds' spatial term (SeedGeodesics.h), per voxel of each node; Weight 0 = off. Step: the
   // length of each explicit edge in voxels (empty: 1 each, the voxel grid).
   SeedGeodesicParameters Geodesic{ 0.0 };
-  std::vector<double> Step;
+  SharedArray<double> Step;
   // How loops over nodes may split across threads.
   ParallelFor Parallel = SerialFor();
 };

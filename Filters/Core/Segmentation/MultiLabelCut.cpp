@@ -162,7 +162,7 @@ std::vector<double> PottsWeights(const GraphEdges& edges, const std::vector<doub
 // Adds the seeds' geodesic spatial term for L labels to `cost` (nodes x L), each node's share
 // weighted by lambda * size; `cache` keeps each label's distances and updates them for its seed edits.
 bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, const ChannelBins& bins,
-  const std::vector<double>* step, const std::vector<std::int16_t>& hard, int L, const SeedGeodesicParameters& geo,
+  const SharedArray<double>& step, const std::vector<std::int16_t>& hard, int L, const SeedGeodesicParameters& geo,
   double lambda, const std::vector<double>& size, std::vector<double>& cost, const ParallelFor& parallel,
   const ProgressFunction& progress, MultiLabelCache* cache)
 {
@@ -179,8 +179,7 @@ bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, 
   }
   GeodesicGraph graph;
   graph.Edges = &edges;
-  graph.Value = value.data();
-  graph.Nodes = n;
+  graph.Value = std::move(value);
   graph.Step = step;
   std::vector<std::uint8_t> kind(n);
   for (std::int64_t p = 0; p < n; ++p)
@@ -289,9 +288,9 @@ std::string CheckInputs(const LabelledSeeds& seeds, bool sizesMatch, const char*
 // What both cuts do once their graph, region costs and hard labels are made: the seeds' geodesic
 // term (Task Object), the Potts weights, alpha-expansion from `start` and the connectivity rule.
 // `mean` holds the nodes' channel vectors, `size` their voxel counts (empty: 1 each), `step` the
-// explicit edges' lengths (null: the grid), `contact` their contacts (empty: 1 each).
+// explicit edges' lengths (empty: the grid), `contact` their contacts (empty: 1 each).
 void SolveLabels(PottsProblem& pr, std::vector<std::int16_t> hard, const std::vector<double>& mean, const ChannelBins& bins,
-  const std::vector<double>* step, const std::vector<double>& contact, const std::vector<double>& size,
+  const SharedArray<double>& step, const std::vector<double>& contact, const std::vector<double>& size,
   const std::vector<std::uint8_t>& border, const SeededCutParameters& par, const MultiLabelParameters& multi,
   std::vector<std::uint8_t> start, const ParallelFor& parallel, const ProgressFunction& progress, MultiLabelCache* cache,
   Clock::time_point t0, MultiLabelResult& r)
@@ -807,8 +806,8 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
       }
     }
   });
-  const std::vector<double> ownStep = data.CentreSteps.size() == faces->A.size() ? std::vector<double>() : CentreDistances(mesh, *faces);
-  const std::vector<double>& step = ownStep.empty() ? data.CentreSteps : ownStep;
+  const SharedArray<double> step =
+    data.CentreSteps.size() == faces->A.size() ? data.CentreSteps : SharedArray<double>(CentreDistances(mesh, *faces));
   std::vector<std::uint8_t> border(n, 0);
   for (std::int64_t e : faces->HullElement)
   {
@@ -831,7 +830,7 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
     cache->WeightContact = par.ScaleByContact;
   }
   const bool weighted = cache && static_cast<std::int64_t>(cache->Weight.size()) == edges.Size();
-  SolveLabels(pr, hard, mean, bins, &step, weighted ? std::vector<double>() : ContactInVoxelFaces(mesh, par.ScaleByContact),
+  SolveLabels(pr, hard, mean, bins, step, weighted ? std::vector<double>() : ContactInVoxelFaces(mesh, par.ScaleByContact),
     count, border, par, multi, std::move(start), parallel, progress, cache, t0, r);
   if (!r.Error.empty() || r.Aborted)
   {
@@ -877,7 +876,7 @@ MultiLabelResult MultiLabelVoxelCut(const std::vector<double>& values, const Cha
       pr.Cost[v * L + l] = par.Lambda * costs[l][bins.Bin[v]];
     }
   }
-  SolveLabels(pr, hard, values, bins, nullptr, {}, {}, BorderVoxels(g), par, multi, {}, SerialFor(), progress, nullptr, t0, r);
+  SolveLabels(pr, hard, values, bins, {}, {}, {}, BorderVoxels(g), par, multi, {}, SerialFor(), progress, nullptr, t0, r);
   return r;
 }
 } // namespace featuremesh

@@ -28,7 +28,7 @@ constexpr std::int64_t ConcurrentNodes = std::int64_t(1) << 20;
 class Adjacency
 {
 public:
-  Adjacency(const GraphEdges& edges, std::int64_t nodes, const std::vector<double>* step)
+  Adjacency(const GraphEdges& edges, std::int64_t nodes, const SharedArray<double>& step)
   {
     if (edges.IsGrid())
     {
@@ -37,7 +37,7 @@ public:
       return;
     }
     const std::int64_t m = edges.Size();
-    const bool unit = !step || step->empty();
+    const bool unit = step.empty();
     this->Offset.assign(nodes + 1, 0);
     for (std::int64_t e = 0; e < m; ++e)
     {
@@ -54,7 +54,7 @@ public:
     for (std::int64_t e = 0; e < m; ++e)
     {
       const std::int64_t a = edges.First()[e], b = edges.Second()[e];
-      const double length = unit ? 1.0 : (*step)[e];
+      const double length = unit ? 1.0 : step[e];
       this->Neighbour[next[a]] = b;
       this->Step[next[a]++] = length;
       this->Neighbour[next[b]] = a;
@@ -92,10 +92,10 @@ private:
 
 // A path of length d at p extended to its neighbour q: the intensity step in units of the range,
 // plus the travel.
-inline double Extended(double d, const GeodesicGraph& g, std::int64_t p, std::int64_t q, double step, double inverseScale,
+inline double Extended(double d, const double* value, std::int64_t p, std::int64_t q, double step, double inverseScale,
   double lengthWeight)
 {
-  return d + std::fabs(g.Value[q] - g.Value[p]) * inverseScale + lengthWeight * step;
+  return d + std::fabs(value[q] - value[p]) * inverseScale + lengthWeight * step;
 }
 
 // A radix heap (Ahuja, Mehlhorn, Orlin & Tarjan 1990) of 8-byte entries, a 32-bit key above a
@@ -160,7 +160,8 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   const std::vector<std::int64_t>& start, double scale, double lengthWeight, DistanceField& field,
   const ProgressFunction& progress)
 {
-  const std::int64_t n = g.Nodes;
+  const std::int64_t n = g.Nodes();
+  const double* value = g.Value.data();
   if (field.Distance.empty())
   {
     field.Distance.assign(n, std::numeric_limits<double>::infinity());
@@ -209,7 +210,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
     }
     const std::int64_t root = field.Root[p];
     adjacency.ForEach(p, [&](std::int64_t q, double step) {
-      const double candidate = Extended(d, g, p, q, step, inverse, lengthWeight);
+      const double candidate = Extended(d, value, p, q, step, inverse, lengthWeight);
       if (candidate < distance[q])
       {
         distance[q] = candidate;
@@ -237,13 +238,13 @@ bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::
   std::set_difference(after.begin(), after.end(), before.begin(), before.end(), std::back_inserter(added));
   if (!removed.empty())
   {
-    std::vector<std::uint8_t> gone(g.Nodes, 0);
+    std::vector<std::uint8_t> gone(g.Nodes(), 0);
     for (std::int64_t r : removed)
     {
       gone[r] = 1;
     }
     std::vector<std::int64_t> orphans;
-    for (std::int64_t p = 0; p < g.Nodes; ++p)
+    for (std::int64_t p = 0; p < g.Nodes(); ++p)
     {
       if (field.Root[p] >= 0 && gone[field.Root[p]])
       {
@@ -258,7 +259,7 @@ bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::
       adjacency.ForEach(p, [&](std::int64_t q, double step) {
         if (field.Root[q] >= 0)
         {
-          const double candidate = Extended(field.Distance[q], g, q, p, step, inverse, lengthWeight);
+          const double candidate = Extended(field.Distance[q], g.Value.data(), q, p, step, inverse, lengthWeight);
           if (candidate < field.Distance[p])
           {
             field.Distance[p] = candidate;
@@ -297,7 +298,7 @@ std::vector<std::int64_t> SeedNodes(const std::vector<std::uint8_t>& hard, std::
 struct SeedGeodesicCache::Kept
 {
   GraphEdges Edges;
-  std::vector<double> Value, Step;
+  SharedArray<double> Value, Step; // shared with the cut's problem
   double Scale = 0.0, LengthWeight = 0.0;
   // Depends on the graph alone: kept across a change of scale or length weight.
   std::shared_ptr<const Adjacency> Neighbours;
@@ -307,10 +308,7 @@ struct SeedGeodesicCache::Kept
 
   bool SameGraph(const GeodesicGraph& g) const
   {
-    const std::vector<double> none;
-    const std::vector<double>& step = g.Step ? *g.Step : none;
-    return this->Edges.Same(*g.Edges) && static_cast<std::int64_t>(this->Value.size()) == g.Nodes &&
-      std::equal(this->Value.begin(), this->Value.end(), g.Value) && this->Step == step;
+    return this->Edges.Same(*g.Edges) && this->Value == g.Value && this->Step == g.Step;
   }
 };
 
@@ -330,7 +328,7 @@ std::string ValidateParameters(const SeedGeodesicParameters& p)
 std::vector<double> GeodesicDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
   std::uint8_t seedKind, double scale, double lengthWeight, const ProgressFunction& progress)
 {
-  const Adjacency adjacency(*graph.Edges, graph.Nodes, graph.Step);
+  const Adjacency adjacency(*graph.Edges, graph.Nodes(), graph.Step);
   DistanceField field;
   if (!Dijkstra(graph, adjacency, SeedNodes(hard, seedKind), {}, UsableScale(scale), lengthWeight, field, progress))
   {
@@ -349,17 +347,14 @@ std::shared_ptr<SeedGeodesicCache::Kept> SeedGeodesicCache::Take(const GeodesicG
   {
     // A new range (a seed sample beyond it moves it) recomputes the distances, not the adjacency.
     std::shared_ptr<const Adjacency> neighbours =
-      sameGraph ? kept->Neighbours : std::make_shared<const Adjacency>(*graph.Edges, graph.Nodes, graph.Step);
+      sameGraph ? kept->Neighbours : std::make_shared<const Adjacency>(*graph.Edges, graph.Nodes(), graph.Step);
     kept = std::make_shared<SeedGeodesicCache::Kept>();
     kept->Neighbours = std::move(neighbours);
     if (cache)
     {
       kept->Edges = graph.Edges->Keepable();
-      kept->Value.assign(graph.Value, graph.Value + graph.Nodes);
-      if (graph.Step)
-      {
-        kept->Step = *graph.Step;
-      }
+      kept->Value = graph.Value;
+      kept->Step = graph.Step;
       kept->Scale = scale;
       kept->LengthWeight = lengthWeight;
     }
@@ -397,7 +392,7 @@ bool UpdateKinds(const GeodesicGraph& graph, std::vector<std::vector<std::int64_
     return UpdateField(graph, *kept.Neighbours, kept.Seeds[k], seeds[k], scale, lengthWeight, kept.Field[k], report);
   };
   const std::int64_t count = static_cast<std::int64_t>(update.size());
-  if (graph.Nodes <= ConcurrentNodes)
+  if (graph.Nodes() <= ConcurrentNodes)
   {
     parallel(count, 1, [&](std::int64_t i0, std::int64_t i1) {
       for (std::int64_t i = i0; i < i1; ++i)
@@ -410,7 +405,7 @@ bool UpdateKinds(const GeodesicGraph& graph, std::vector<std::vector<std::int64_
       return false;
     }
   }
-  for (std::int64_t i = 0; i < count && graph.Nodes > ConcurrentNodes; ++i)
+  for (std::int64_t i = 0; i < count && graph.Nodes() > ConcurrentNodes; ++i)
   {
     if (!run(update[i], SubProgress(progress, 0.9 * i / count, 0.9 * (i + 1) / count)))
     {
@@ -459,7 +454,7 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
   costObject.clear();
   costBackground.clear();
   std::vector<std::vector<std::int64_t>> seeds{ SeedNodes(hard, 1), SeedNodes(hard, 2) };
-  if (par.Weight <= 0.0 || seeds[0].empty() || seeds[1].empty() || graph.Nodes == 0)
+  if (par.Weight <= 0.0 || seeds[0].empty() || seeds[1].empty() || graph.Nodes() == 0)
   {
     return true;
   }
@@ -472,9 +467,9 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
   const std::vector<double>& toObject = kept->Field[0].Distance;
   const std::vector<double>& toBackground = kept->Field[1].Distance;
   constexpr double mix = 0.01;
-  costObject.resize(graph.Nodes);
-  costBackground.resize(graph.Nodes);
-  parallel(graph.Nodes, 65536, [&](std::int64_t p0, std::int64_t p1) {
+  costObject.resize(graph.Nodes());
+  costBackground.resize(graph.Nodes());
+  parallel(graph.Nodes(), 65536, [&](std::int64_t p0, std::int64_t p1) {
     for (std::int64_t p = p0; p < p1; ++p)
     {
       const double dO = toObject[p], dB = toBackground[p];

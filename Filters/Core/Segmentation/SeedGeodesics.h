@@ -10,6 +10,7 @@
 
 #include "GraphEdges.h"
 #include "Parallel.h"
+#include "SharedArray.h"
 
 #include <cstdint>
 #include <memory>
@@ -30,13 +31,13 @@ struct SeedGeodesicParameters
 };
 
 // The graph the distances run on: node values and edges; for explicit edges the length of each in
-// voxels (Step, centre to centre); the grid's edges are one voxel long.
+// voxels (Step, centre to centre); the grid's edges are one voxel long. A cache shares the arrays.
 struct GeodesicGraph
 {
   const GraphEdges* Edges = nullptr;
-  const double* Value = nullptr;
-  std::int64_t Nodes = 0;
-  const std::vector<double>* Step = nullptr; // per explicit edge; null or empty: 1 each (a grid)
+  SharedArray<double> Value;
+  SharedArray<double> Step; // per explicit edge; empty: 1 each (a grid)
+  std::int64_t Nodes() const { return static_cast<std::int64_t>(this->Value.size()); }
 };
 
 // Geodesic distance of every node from the nodes with hard[p] == seedKind (infinity where none is

@@ -124,8 +124,8 @@ bool PrepareVoxelOwners(const SimplexMesh& mesh, SuperVoxelCutData& data, const 
   return !data.Owner.empty();
 }
 
-SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutData& data, const std::vector<double>& mean,
-  const std::vector<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
+SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutData& data, const SharedArray<double>& mean,
+  const SharedArray<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
   const std::vector<std::int64_t>& backgroundVoxels, const VoxelValueFunction& voxelValue,
   const SuperVoxelCutParameters& parameters, const ParallelFor& parallel, const ProgressFunction& progress,
   MaxFlowCache* flow)
@@ -205,7 +205,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   if (parameters.Task == Task::Object)
   {
     pr.Geodesic = parameters.Geodesic;
-    pr.Step = data.CentreSteps.size() == adj.A.size() ? data.CentreSteps : CentreDistances(mesh, adj);
+    pr.Step = data.CentreSteps.size() == adj.A.size() ? data.CentreSteps : SharedArray<double>(CentreDistances(mesh, adj));
   }
   result.SetupSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
   result.Cut = BoykovJollyCut(pr, parameters, progress, flow);
@@ -221,7 +221,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
     border[e] = 1;
   }
   result.Cut.ConnectivityChanged = ApplyConnectivity(ConnectivityFor(parameters.Connectivity, parameters.Task), result.Cut.Label, pr.Edges, pr.Hard,
-    border, NoProgress(), &result.Cut.ObjectComponentVoxels, voxelCount);
+    border, NoProgress(), &result.Cut.ObjectComponentVoxels, voxelCount.Vector());
   result.BoundaryFaces = LabelBoundaryFaces(mesh, adj, result.Cut.Label);
   return result;
 }

@@ -116,8 +116,9 @@ struct SuperVoxelCutData
   VoxelOwnerMap Owner;
   // The voxel values with their elements (viewed); empty without voxel values.
   NodeVoxelValues Voxels;
-  // CentreDistances of the mesh, for the geodesic spatial term (made by PrepareVoxelOwners).
-  std::vector<double> CentreSteps;
+  // CentreDistances of the mesh, for the geodesic spatial term (made by PrepareVoxelOwners); the
+  // cuts' problems and caches share it.
+  SharedArray<double> CentreSteps;
   bool HasVoxelValues() const { return !this->Voxels.Empty(); }
 };
 
@@ -148,8 +149,8 @@ using VoxelValueFunction = std::function<double(std::int64_t)>;
 // the seed elements (or, without SampleSeedElements, those near each seed voxel, read through
 // `voxelValue`) and the voxel region term is available. `flow` (optional) keeps the max-flow for
 // the next cut of the same mesh.
-SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutData& data, const std::vector<double>& mean,
-  const std::vector<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
+SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutData& data, const SharedArray<double>& mean,
+  const SharedArray<double>& voxelCount, const std::vector<std::int64_t>& objectVoxels,
   const std::vector<std::int64_t>& backgroundVoxels, const VoxelValueFunction& voxelValue,
   const SuperVoxelCutParameters& parameters, const ParallelFor& parallel, const ProgressFunction& progress = NoProgress(),
   MaxFlowCache* flow = nullptr);
