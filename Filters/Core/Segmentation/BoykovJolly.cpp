@@ -506,7 +506,7 @@ struct MaxFlowCache::Kept
   double SigmaParameter = 0.0, Sigma = 0.0, WeightTotal = 0.0;
   std::unique_ptr<double[]> Weight; // one per edge
   // The terminal capacities of the last flow.
-  std::vector<double> Source, Sink;
+  std::unique_ptr<double[]> Source, Sink;
 };
 
 // Node p's voxels as runs of one bin (ascending) at [Offset[p], Offset[p + 1]), for the bins of
@@ -1175,13 +1175,15 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
       kept = NewKept(pr, par.Sigma, r.Sigma, total, std::move(boundary.Weight));
     }
     kept->Graph = g;
-    kept->Source.resize(n);
-    kept->Sink.resize(n);
+    // The capacities in place of the region costs they were made of (a node's read its own only).
     for (std::int64_t p = 0; p < n; ++p)
     {
-      kept->Source[p] = source(p);
-      kept->Sink[p] = sink(p);
+      const double s = source(p), t = sink(p);
+      regionBackground[p] = s;
+      regionObject[p] = t;
     }
+    kept->Source = std::move(regionBackground);
+    kept->Sink = std::move(regionObject);
     cache->State = kept;
   }
   r.FlowSeconds = std::chrono::duration<double>(Clock::now() - t1).count();

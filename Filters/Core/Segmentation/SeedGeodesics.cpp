@@ -24,11 +24,13 @@ constexpr std::int64_t CheckEvery = (std::int64_t(1) << 16) - 1;
 constexpr std::int64_t ConcurrentNodes = std::int64_t(1) << 20;
 
 // Neighbours of a node with the step to each: explicit edges as CSR (two passes, count then
-// insert), the grid's from the index.
+// insert) of 32-bit neighbour and edge ids (the cuts allow fewer than 2^31 of each), the steps read
+// from the graph's shared array; the grid's from the index.
 class Adjacency
 {
 public:
   Adjacency(const GraphEdges& edges, std::int64_t nodes, const SharedArray<double>& step)
+    : Step(step)
   {
     if (edges.IsGrid())
     {
@@ -37,7 +39,6 @@ public:
       return;
     }
     const std::int64_t m = edges.Size();
-    const bool unit = step.empty();
     this->Offset.assign(nodes + 1, 0);
     for (std::int64_t e = 0; e < m; ++e)
     {
@@ -49,16 +50,18 @@ public:
       this->Offset[p + 1] += this->Offset[p];
     }
     this->Neighbour.resize(2 * m);
-    this->Step.resize(2 * m);
+    this->Edge.resize(this->Step.empty() ? 0 : 2 * m);
     std::vector<std::int64_t> next(this->Offset.begin(), this->Offset.end() - 1);
     for (std::int64_t e = 0; e < m; ++e)
     {
       const std::int64_t a = edges.First()[e], b = edges.Second()[e];
-      const double length = unit ? 1.0 : step[e];
-      this->Neighbour[next[a]] = b;
-      this->Step[next[a]++] = length;
-      this->Neighbour[next[b]] = a;
-      this->Step[next[b]++] = length;
+      if (!this->Edge.empty())
+      {
+        this->Edge[next[a]] = static_cast<std::uint32_t>(e);
+        this->Edge[next[b]] = static_cast<std::uint32_t>(e);
+      }
+      this->Neighbour[next[a]++] = static_cast<std::uint32_t>(b);
+      this->Neighbour[next[b]++] = static_cast<std::uint32_t>(a);
     }
   }
 
@@ -78,16 +81,18 @@ public:
       if (k + 1 < this->Dims[2]) f(p + nxy, 1.0);
       return;
     }
+    const double* step = this->Step.data();
     for (std::int64_t s = this->Offset[p]; s < this->Offset[p + 1]; ++s)
     {
-      f(this->Neighbour[s], this->Step[s]);
+      f(static_cast<std::int64_t>(this->Neighbour[s]), step ? step[this->Edge[s]] : 1.0);
     }
   }
 
 private:
   std::array<std::int64_t, 3> Dims{ { 0, 0, 0 } };
-  std::vector<std::int64_t> Offset, Neighbour;
-  std::vector<double> Step;
+  std::vector<std::int64_t> Offset;
+  std::vector<std::uint32_t> Neighbour, Edge;
+  SharedArray<double> Step; // held: a kept adjacency outlives the problem it was made for
 };
 
 // A path of length d at p extended to its neighbour q: the intensity step in units of the range,
@@ -149,7 +154,7 @@ private:
 struct DistanceField
 {
   std::vector<double> Distance;
-  std::vector<std::int64_t> Root; // -1 unreachable
+  std::vector<std::int32_t> Root; // -1 unreachable (fewer than 2^31 nodes)
 };
 
 // Dijkstra into `field` from `seeds` (distance 0) and from `start` (nodes whose distances `field`
@@ -186,7 +191,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   for (std::int64_t p : seeds)
   {
     distance[p] = 0.0;
-    field.Root[p] = p;
+    field.Root[p] = static_cast<std::int32_t>(p);
     heap.Push(key(0.0, p));
   }
   for (std::int64_t p : start)
@@ -208,7 +213,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
     {
       return false;
     }
-    const std::int64_t root = field.Root[p];
+    const std::int32_t root = field.Root[p];
     adjacency.ForEach(p, [&](std::int64_t q, double step) {
       const double candidate = Extended(d, value, p, q, step, inverse, lengthWeight);
       if (candidate < distance[q])
