@@ -1,6 +1,7 @@
 #include "vtkFeatureMeshVoxelOwners.h"
 
 #include "Contract.h"
+#include "Digest.h"
 #include "Memory.h"
 
 #include "vtkCellArray.h"
@@ -36,30 +37,18 @@ vtkSmartPointer<vtkIntArray> NewVoxelOwnerArray(vtkInformationVector* outputVect
 
 std::uint64_t MeshDigest(vtkUnstructuredGrid* grid)
 {
-  // FNV-1a over 64-bit words (and the tail bytes) of each array, with its type and length.
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  auto mix = [&h](std::uint64_t w) { h = (h ^ w) * 0x100000001b3ULL; };
+  // Each array's type, length and bytes.
+  std::uint64_t h = DigestSeed;
   auto add = [&](vtkDataArray* a) {
     if (!a)
     {
-      mix(0);
+      h = DigestWord(h, 0);
       return;
     }
     const size_t bytes = static_cast<size_t>(a->GetDataSize()) * static_cast<size_t>(a->GetDataTypeSize());
-    mix(static_cast<std::uint64_t>(a->GetDataType()));
-    mix(bytes);
-    const unsigned char* p = static_cast<const unsigned char*>(a->GetVoidPointer(0));
-    size_t i = 0;
-    for (; i + 8 <= bytes; i += 8)
-    {
-      std::uint64_t w;
-      std::memcpy(&w, p + i, 8);
-      mix(w);
-    }
-    for (; i < bytes; ++i)
-    {
-      mix(p[i]);
-    }
+    h = DigestWord(h, static_cast<std::uint64_t>(a->GetDataType()));
+    h = DigestWord(h, bytes);
+    h = DigestBytes(h, a->GetVoidPointer(0), bytes);
   };
   add(grid->GetPoints() ? grid->GetPoints()->GetData() : nullptr);
   vtkCellArray* cells = grid->GetCells();

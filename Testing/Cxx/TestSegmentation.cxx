@@ -312,8 +312,8 @@ TEST(BoykovJolly, KeptCutsEqualFreshCuts)
   // seed edits through one MaxFlowCache, with the values sorted and bounded: a binning seen first
   // (summed from the sorted values, or binned from the voxels), the same binning again (kept as
   // runs), read from the runs, a seed sample beyond the range (a new binning),
-  // then a change of the bins and of sigma (new weights). Each cut equals a fresh one: the same
-  // labels and flow.
+  // then a change of the bins and of sigma (new weights), and of the contacts (which the cache
+  // knows by their digest only). Each cut equals a fresh one: the same labels and flow.
   std::mt19937 rng(11);
   std::normal_distribution<double> noise(0.0, 3.0);
   std::uniform_int_distribution<int> count(1, 40);
@@ -342,18 +342,24 @@ TEST(BoykovJolly, KeptCutsEqualFreshCuts)
     BoykovJollyParameters par;
     par.Lambda = 1.0;
     const std::vector<std::vector<double>> objectSamples = { { 20, 22, 18, 25 }, { 20, 22, 18, 25 }, { 21, 19, 23, 17 },
-      { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 } };
+      { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 }, { 21, 19, 23, 60 },
+      { 21, 19, 23, 60 } };
     // Edits 0-3 on held (owned) edge lists, which the cache keeps as they are; from 4 on a view of
     // equal lists (compared by value: the kept flow still applies), which the new sigma of edit 6
     // makes the cache copy, and edit 7 reuses.
     const std::vector<std::int64_t> A(pr.Edges.First(), pr.Edges.First() + pr.Edges.Size());
     const std::vector<std::int64_t> B(pr.Edges.Second(), pr.Edges.Second() + pr.Edges.Size());
     MaxFlowCache cache;
+    double lastFlow = 0.0;
     for (size_t edit = 0; edit < objectSamples.size(); ++edit)
     {
       if (edit == 4)
       {
         pr.Edges = GraphEdges(A, B);
+      }
+      if (edit == 8)
+      {
+        pr.Contact.Mutable()[24] = 1e12; // the edge between the plateaus: its weight is ~1e-12
       }
       pr.ObjectSamples = objectSamples[edit];
       pr.BackgroundSamples = { 5, 3, 7, 4 + static_cast<double>(edit) };
@@ -362,6 +368,11 @@ TEST(BoykovJolly, KeptCutsEqualFreshCuts)
       const CutResult kept = BoykovJollyCut(pr, par, NoProgress(), &cache);
       const CutResult fresh = BoykovJollyCut(pr, par);
       ASSERT_TRUE(kept.Error.empty() && fresh.Error.empty()) << edit;
+      if (edit == 8)
+      {
+        EXPECT_GT(std::fabs(fresh.Flow - lastFlow), 1e-5 * fresh.Flow); // the new contact matters
+      }
+      lastFlow = fresh.Flow;
       EXPECT_EQ(kept.Label, fresh.Label) << edit;
       EXPECT_NEAR(kept.Flow, fresh.Flow, 1e-12 * fresh.Flow) << edit;
       const auto object = std::count(kept.Label.begin(), kept.Label.end(), 1);

@@ -1,4 +1,5 @@
 #include "BoykovJolly.h"
+#include "Digest.h"
 #include "Memory.h"
 #include "Percentile.h"
 
@@ -499,10 +500,11 @@ using Flow = maxflow::Graph_DDD;
 struct MaxFlowCache::Kept
 {
   std::shared_ptr<Flow> Graph;
-  // The boundary term's inputs (explicit edge lists copied unless held; the arrays shared) and
-  // what it made of them.
+  // The boundary term's inputs (explicit edge lists copied unless held, the values shared, the
+  // contacts by their digest: 64 MB at 512^3 that only this check would hold) and what it made of them.
   GraphEdges Edges;
-  SharedArray<double> Value, Contact;
+  SharedArray<double> Value;
+  std::uint64_t ContactDigest = 0;
   double SigmaParameter = 0.0, Sigma = 0.0, WeightTotal = 0.0;
   std::unique_ptr<double[]> Weight; // one per edge
   // The terminal capacities of the last flow.
@@ -1015,13 +1017,13 @@ bool MaxFlow(const std::shared_ptr<Flow>& g, std::int64_t n, bool reuse, const P
 
 // Step 8: a new record of the graph a re-cut may reuse. Held edge lists and the weights are kept as
 // they are; lists only viewed are copied.
-std::shared_ptr<MaxFlowCache::Kept> NewKept(
-  const CutProblem& pr, double sigmaParameter, double sigma, double weightTotal, std::unique_ptr<double[]> weight)
+std::shared_ptr<MaxFlowCache::Kept> NewKept(const CutProblem& pr, std::uint64_t contactDigest, double sigmaParameter,
+  double sigma, double weightTotal, std::unique_ptr<double[]> weight)
 {
   auto kept = std::make_shared<MaxFlowCache::Kept>();
   kept->Edges = pr.Edges.Keepable();
   kept->Value = pr.Value;
-  kept->Contact = pr.Contact;
+  kept->ContactDigest = contactDigest;
   kept->SigmaParameter = sigmaParameter;
   kept->Sigma = sigma;
   kept->WeightTotal = weightTotal;
@@ -1082,8 +1084,10 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   // 3. The boundary term depends on the graph alone: a kept flow of this very graph lends its
   // weights (and its residual graph, below).
   std::shared_ptr<MaxFlowCache::Kept> kept = cache ? cache->State : nullptr;
+  const std::uint64_t contactDigest =
+    cache ? DigestBytes(DigestWord(DigestSeed, pr.Contact.size()), pr.Contact.data(), pr.Contact.size() * sizeof(double)) : 0;
   const bool reuse = kept && kept->SigmaParameter == par.Sigma && kept->Edges.Same(edges) && kept->Value == pr.Value &&
-    kept->Contact == pr.Contact;
+    kept->ContactDigest == contactDigest;
   BoundaryTerm boundary;
   if (reuse)
   {
@@ -1172,7 +1176,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   {
     if (!reuse)
     {
-      kept = NewKept(pr, par.Sigma, r.Sigma, total, std::move(boundary.Weight));
+      kept = NewKept(pr, contactDigest, par.Sigma, r.Sigma, total, std::move(boundary.Weight));
     }
     kept->Graph = g;
     // The capacities in place of the region costs they were made of (a node's read its own only).

@@ -24,8 +24,8 @@ constexpr std::int64_t CheckEvery = (std::int64_t(1) << 16) - 1;
 constexpr std::int64_t ConcurrentNodes = std::int64_t(1) << 20;
 
 // Neighbours of a node with the step to each: explicit edges as CSR (two passes, count then
-// insert) of 32-bit neighbour and edge ids (the cuts allow fewer than 2^31 of each), the steps read
-// from the graph's shared array; the grid's from the index.
+// insert) of 32-bit neighbour and edge ids and offsets (the cuts allow fewer than 2^31 nodes and
+// edge ends), the steps read from the graph's shared array; the grid's from the index.
 class Adjacency
 {
 public:
@@ -51,7 +51,7 @@ public:
     }
     this->Neighbour.resize(2 * m);
     this->Edge.resize(this->Step.empty() ? 0 : 2 * m);
-    std::vector<std::int64_t> next(this->Offset.begin(), this->Offset.end() - 1);
+    std::vector<std::uint32_t> next(this->Offset.begin(), this->Offset.end() - 1);
     for (std::int64_t e = 0; e < m; ++e)
     {
       const std::int64_t a = edges.First()[e], b = edges.Second()[e];
@@ -82,7 +82,7 @@ public:
       return;
     }
     const double* step = this->Step.data();
-    for (std::int64_t s = this->Offset[p]; s < this->Offset[p + 1]; ++s)
+    for (std::uint32_t s = this->Offset[p]; s < this->Offset[p + 1]; ++s)
     {
       f(static_cast<std::int64_t>(this->Neighbour[s]), step ? step[this->Edge[s]] : 1.0);
     }
@@ -90,8 +90,7 @@ public:
 
 private:
   std::array<std::int64_t, 3> Dims{ { 0, 0, 0 } };
-  std::vector<std::int64_t> Offset;
-  std::vector<std::uint32_t> Neighbour, Edge;
+  std::vector<std::uint32_t> Offset, Neighbour, Edge;
   SharedArray<double> Step; // held: a kept adjacency outlives the problem it was made for
 };
 
