@@ -30,6 +30,11 @@ def sha(*arrays):
     return h.hexdigest()[:16]
 
 
+def ids(array):
+    """Point ids as int64, whatever the cell array stores them in (stages 2 and 3 write 32-bit ids)."""
+    return array.astype(fm.np.int64)
+
+
 def cell_array(data, names):
     for n in (names if isinstance(names, tuple) else (names,)):
         a = data.GetCellData().GetArray(n)
@@ -96,7 +101,7 @@ def main():
             mesh = case.mesh(nodes, Backend=backend)
             m = fm.fetch(mesh)
             tag = "%s/%s" % (name, "CGAL" if backend else "default")
-            lines.append("%s mesh %s" % (tag, sha(fm.v2n(m.GetPoints().GetData()), fm.v2n(m.GetCells().GetConnectivityArray()),
+            lines.append("%s mesh %s" % (tag, sha(fm.v2n(m.GetPoints().GetData()), ids(fm.v2n(m.GetCells().GetConnectivityArray())),
                                                   *[cell_array(m, a) for a in CELL_ARRAYS])))
             lines.append("%s mesh owners %s" % (tag, owners(mesh)))
             cut = case.super_voxel_cut(mesh, **cut_properties)
@@ -105,11 +110,11 @@ def main():
             surface = case.surface_smoothing(cut, **surface_properties)
             f0, f1 = fm.fetch(surface, 0), fm.fetch(surface, 1)
             faces = f0.GetPolys() if f0.GetNumberOfPolys() else f0.GetLines()
-            lines.append("%s surface %s" % (tag, sha(fm.v2n(f1.GetPoints().GetData()), fm.v2n(faces.GetConnectivityArray()))))
+            lines.append("%s surface %s" % (tag, sha(fm.v2n(f1.GetPoints().GetData()), ids(fm.v2n(faces.GetConnectivityArray())))))
             if backend == 0:
                 smoothed = case.smoothing(mesh)
                 s = fm.fetch(smoothed)
-                lines.append("%s smoothed %s" % (tag, sha(fm.v2n(s.GetPoints().GetData()), fm.v2n(s.GetCells().GetConnectivityArray()),
+                lines.append("%s smoothed %s" % (tag, sha(fm.v2n(s.GetPoints().GetData()), ids(fm.v2n(s.GetCells().GetConnectivityArray())),
                                                           *[cell_array(s, a) for a in CELL_ARRAYS])))
                 lines.append("%s smoothed owners %s" % (tag, owners(smoothed)))
         lines.append("%s voxelcut %s" % (name, sha(fm.v2n(fm.fetch(case.voxel_cut(**cut_properties)).GetPointData().GetScalars()))))
