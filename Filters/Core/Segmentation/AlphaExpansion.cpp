@@ -30,9 +30,9 @@ std::string Validate(const PottsProblem& pr)
   {
     return "the graph is empty.";
   }
-  if (pr.Nodes > 2000000000 || 2 * pr.Edges->Size() > 2000000000)
+  if (std::string size = GraphSizeProblem(pr.Nodes, pr.Edges->Size()); !size.empty())
   {
-    return "the graph is too large for the max-flow library (node ids are 32-bit).";
+    return size;
   }
   if (static_cast<std::int64_t>(pr.Cost.size()) != pr.Nodes * pr.Labels ||
     static_cast<std::int64_t>(pr.Weight.size()) != pr.Edges->Size() ||

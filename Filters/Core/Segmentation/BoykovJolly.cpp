@@ -435,9 +435,9 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
   {
     return "the graph is empty.";
   }
-  if (n > static_cast<std::int64_t>(2000000000) || 2 * m > static_cast<std::int64_t>(2000000000))
+  if (std::string size = GraphSizeProblem(n, m); !size.empty())
   {
-    return "the graph is too large for the max-flow library (node ids are 32-bit).";
+    return size;
   }
   const auto& dims = edges.GridDims();
   if ((!pr.Size.empty() && static_cast<std::int64_t>(pr.Size.size()) != n) ||

@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace featuremesh
@@ -191,4 +192,13 @@ private:
   std::int64_t RowsPerBlock = 1;
   std::shared_ptr<const void> Keep;
 };
+
+// Empty when a graph of `nodes` nodes and `edges` edges fits the 32-bit ids of the max-flow
+// library and of the geodesic term's adjacency, else a sentence.
+inline std::string GraphSizeProblem(std::int64_t nodes, std::int64_t edges)
+{
+  constexpr std::int64_t most = 2000000000;
+  return nodes > most || 2 * edges > most ? "the graph is too large for the max-flow library (node ids are 32-bit)."
+                                          : std::string();
+}
 } // namespace featuremesh

@@ -296,6 +296,11 @@ void SolveLabels(PottsProblem& pr, std::vector<std::int16_t> hard, const std::ve
   Clock::time_point t0, MultiLabelResult& r)
 {
   const GraphEdges& edges = *pr.Edges;
+  r.Error = GraphSizeProblem(pr.Nodes, edges.Size()); // before the geodesic term's 32-bit ids
+  if (!r.Error.empty())
+  {
+    return;
+  }
   if (par.Task == Task::Object && par.Geodesic.Weight > 0.0)
   {
     const auto g0 = Clock::now();
