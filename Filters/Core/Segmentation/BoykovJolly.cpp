@@ -506,7 +506,6 @@ struct MaxFlowCache::Kept
   SharedArray<double> Value;
   std::uint64_t ContactDigest = 0;
   double SigmaParameter = 0.0, Sigma = 0.0, WeightTotal = 0.0;
-  std::unique_ptr<double[]> Weight; // one per edge
   // The terminal capacities of the last flow.
   std::unique_ptr<double[]> Source, Sink;
 };
@@ -1015,10 +1014,10 @@ bool MaxFlow(const std::shared_ptr<Flow>& g, std::int64_t n, bool reuse, const P
     progress, flow);
 }
 
-// Step 8: a new record of the graph a re-cut may reuse. Held edge lists and the weights are kept as
-// they are; lists only viewed are copied.
+// Step 8: a new record of the graph a re-cut may reuse. Held edge lists are kept as they are, lists
+// only viewed are copied; the weights live in the graph's capacities only.
 std::shared_ptr<MaxFlowCache::Kept> NewKept(const CutProblem& pr, std::uint64_t contactDigest, double sigmaParameter,
-  double sigma, double weightTotal, std::unique_ptr<double[]> weight)
+  double sigma, double weightTotal)
 {
   auto kept = std::make_shared<MaxFlowCache::Kept>();
   kept->Edges = pr.Edges.Keepable();
@@ -1027,7 +1026,6 @@ std::shared_ptr<MaxFlowCache::Kept> NewKept(const CutProblem& pr, std::uint64_t 
   kept->SigmaParameter = sigmaParameter;
   kept->Sigma = sigma;
   kept->WeightTotal = weightTotal;
-  kept->Weight = std::move(weight);
   return kept;
 }
 // Step 5b: lambda times both region costs, and K's share of them (the larger per node) added to
@@ -1081,8 +1079,8 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   const double width = (high - low) / r.Bins;
   const HistogramBins bin(r.Bins, low, width);
 
-  // 3. The boundary term depends on the graph alone: a kept flow of this very graph lends its
-  // weights (and its residual graph, below).
+  // 3. The boundary term depends on the graph alone: a kept flow of this very graph holds its
+  // weights in its residual graph (below).
   std::shared_ptr<MaxFlowCache::Kept> kept = cache ? cache->State : nullptr;
   const std::uint64_t contactDigest =
     cache ? DigestBytes(DigestWord(DigestSeed, pr.Contact.size()), pr.Contact.data(), pr.Contact.size() * sizeof(double)) : 0;
@@ -1099,7 +1097,6 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     return r;
   }
   r.Sigma = boundary.Sigma;
-  const double* weight = reuse ? kept->Weight.get() : boundary.Weight.get();
   double total = boundary.Total;
   if (aborted(progress(0.2)))
   {
@@ -1138,7 +1135,8 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   std::shared_ptr<Flow> g;
   try
   {
-    g = reuse ? kept->Graph : NewFlowGraph(edges, weight, n, source, sink, SubProgress(progress, 0.35, 0.5));
+    g = reuse ? kept->Graph : NewFlowGraph(edges, boundary.Weight.get(), n, source, sink, SubProgress(progress, 0.35, 0.5));
+    boundary.Weight.reset(); // in the graph's capacities now
     if (aborted(g != nullptr))
     {
       return r;
@@ -1176,7 +1174,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   {
     if (!reuse)
     {
-      kept = NewKept(pr, contactDigest, par.Sigma, r.Sigma, total, std::move(boundary.Weight));
+      kept = NewKept(pr, contactDigest, par.Sigma, r.Sigma, total);
     }
     kept->Graph = g;
     // The capacities in place of the region costs they were made of (a node's read its own only).
