@@ -17,7 +17,6 @@
 #include "vtkWeakPointer.h"
 
 #include <algorithm>
-#include <cstring>
 #include <mutex>
 namespace featuremesh
 {

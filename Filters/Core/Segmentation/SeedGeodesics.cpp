@@ -258,12 +258,13 @@ bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::
       }
     }
     const double inverse = 1.0 / scale;
+    const double* value = g.Value.data();
     for (std::int64_t p : orphans)
     {
       adjacency.ForEach(p, [&](std::int64_t q, double step) {
         if (field.Root[q] >= 0)
         {
-          const double candidate = Extended(field.Distance[q], g.Value.data(), q, p, step, inverse, lengthWeight);
+          const double candidate = Extended(field.Distance[q], value, q, p, step, inverse, lengthWeight);
           if (candidate < field.Distance[p])
           {
             field.Distance[p] = candidate;
