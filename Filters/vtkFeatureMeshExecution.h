@@ -59,7 +59,7 @@ void SetClampedParameter(vtkObject* filter, Parameter& parameter, int value, int
   double cls::GetGeodesicWeight() { return this->Geodesic.Weight; }                                                \
   void cls::SetGeodesicLength(double value) { featuremesh::SetParameter(this, this->Geodesic.LengthWeight, value); } \
   double cls::GetGeodesicLength() { return this->Geodesic.LengthWeight; }                                          \
-  void cls::SetChannelModel(int value) { featuremesh::SetClampedParameter(this, this->Channels, value, 0, 1); }    \
+  void cls::SetChannelModel(int value) { featuremesh::SetClampedParameter(this, this->Channels, value, 0, 2); }    \
   int cls::GetChannelModel() { return static_cast<int>(this->Channels); }
 
 // What a run depends on: the newest modification of the filter or of anything upstream, and the

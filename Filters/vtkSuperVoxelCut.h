@@ -110,8 +110,8 @@ public:
   /// without case; 0 background, 1..k objects).
   vtkSetStdStringFromCharMacro(SeedLabelArray);
   vtkGetCharFromStdStringMacro(SeedLabelArray);
-  /// With labelled seeds on a multi-channel image (featuremesh::ChannelModel): 0 one joint density
-  /// over the channels (default), 1 the product of one density per channel.
+  /// With labelled seeds, each label's density over the channels (featuremesh::ChannelModel): 0 one
+  /// joint kernel density, 1 the product of one per channel (default), 2 a Gaussian mixture.
   virtual void SetChannelModel(int value);
   virtual int GetChannelModel();
   /// Names of labels 0..k, separated by ';' (optional): the outputs' LabelNames field data.

@@ -2,6 +2,7 @@
 #include "AlphaExpansion.h"
 #include "DelaunayImageMesh.h"
 #include "ElementRasterizer.h"
+#include "GaussianMixture.h"
 #include "MultiLabelCut.h"
 #include "SimplexMesh.h"
 #include "SeedGeodesics.h"
@@ -344,7 +345,7 @@ TEST(MultiLabel, TheSecondChannelTellsTheLabelsApart)
   vp.Task = Task::Class; // appearance and boundary alone
   SuperVoxelCutParameters sp;
   sp.Task = Task::Class;
-  for (ChannelModel model : { ChannelModel::Joint, ChannelModel::Independent })
+  for (ChannelModel model : { ChannelModel::Joint, ChannelModel::Independent, ChannelModel::GaussianMixture })
   {
     MultiLabelParameters multi;
     multi.Channels = model;
@@ -357,6 +358,44 @@ TEST(MultiLabel, TheSecondChannelTellsTheLabelsApart)
   Lattice m;
   ASSERT_TRUE(m.Make(g, first, 1));
   EXPECT_LT(p.Correct(m.Cut(p.Seeds, sp)), 0.8);
+}
+
+TEST(MultiLabel, AGaussianMixtureFindsItsComponents)
+{
+  // Binned samples of two correlated Gaussians (weights 0.7 / 0.3): BIC picks two of at most four,
+  // and EM finds their weights and means.
+  std::mt19937 rng(3);
+  std::normal_distribution<double> z(0.0, 1.0);
+  const int per = 64;
+  std::vector<double> count(per * per, 0.0), points(2 * per * per);
+  for (int b = 0; b < per * per; ++b)
+  {
+    points[2 * b] = b % per;
+    points[2 * b + 1] = b / per;
+  }
+  for (int i = 0; i < 20000; ++i)
+  {
+    const bool first = i % 10 < 7;
+    const double u = z(rng), v = z(rng);
+    const double x = first ? 16.0 + 3.0 * u : 44.0 + 2.0 * u;
+    const double y = first ? 20.0 + 2.0 * u + 1.5 * v : 40.0 - 1.5 * u + 2.0 * v;
+    const int bx = std::clamp(static_cast<int>(std::floor(x + 0.5)), 0, per - 1);
+    const int by = std::clamp(static_cast<int>(std::floor(y + 0.5)), 0, per - 1);
+    count[by * per + bx] += 1.0;
+  }
+  const GaussianMixture g = FitGaussianMixture(points, count, 2, 4, { 1.0 / 12.0, 1.0 / 12.0 });
+  ASSERT_EQ(g.Components(), 2);
+  const int a = g.Mean[0] < g.Mean[2] ? 0 : 1, b = 1 - a;
+  EXPECT_NEAR(g.Weight[a], 0.7, 0.01);
+  EXPECT_NEAR(g.Mean[2 * a], 16.0, 0.1);
+  EXPECT_NEAR(g.Mean[2 * a + 1], 20.0, 0.1);
+  EXPECT_NEAR(g.Mean[2 * b], 44.0, 0.1);
+  EXPECT_NEAR(g.Mean[2 * b + 1], 40.0, 0.1);
+  EXPECT_GT(g.Covariance[4 * a + 1], 4.0); // cov(x, y) = 6 in the first, -3 in the second
+  EXPECT_LT(g.Covariance[4 * b + 1], -2.0);
+  const double atMean[2] = { 16.0, 20.0 }, between[2] = { 30.0, 30.0 };
+  EXPECT_GT(g.Density(atMean), 100.0 * g.Density(between));
+  EXPECT_EQ(FitGaussianMixture(points, std::vector<double>(per * per, 0.0), 2, 4, { 1.0, 1.0 }).Components(), 0);
 }
 
 TEST(MultiLabel, AutomaticBinsTellTissuesOfACTApart)

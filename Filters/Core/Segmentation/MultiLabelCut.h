@@ -8,7 +8,7 @@
 // of |m_p - m_q| over the graph's edges (automatic) as in the binary cut. Pr(x | l) is a density of
 // label l's seed samples on a grid of bins over the channels' 0.5-99.5 percentile ranges: joint
 // (a kernel density on the n-dimensional grid) or independent (the product of one per channel),
-// mixed with 1 % uniform. For Task Object each label also pays the seeds' geodesic spatial term
+// or a Gaussian mixture (ChannelModel), mixed with 1 % uniform. For Task Object each label also pays the seeds' geodesic spatial term
 // (SeedGeodesics.h) generalised to k + 1 labels: Pr(l) = (1 / D_l) / sum_j (1 / D_j).
 #pragma once
 
@@ -29,6 +29,9 @@ enum class ChannelModel : int
   Joint = 0,
   // The product of one density per channel (naive Bayes).
   Independent = 1,
+  // A Gaussian mixture over all channels, fitted to the seed samples by EM (GaussianMixture.h): a
+  // smooth, parametric density where a label's samples are multimodal (a stomach's wall and content).
+  GaussianMixture = 2,
 };
 
 // Seeds with labels: the voxel each lies in and its label (0 background, 1..255 objects).
