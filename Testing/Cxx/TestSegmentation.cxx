@@ -959,7 +959,8 @@ TEST(SeedGeodesics, DijkstraMatchesBellmanFord)
     for (std::size_t e = 0; e < a.size(); ++e)
       for (const auto& [p, q] : { std::make_pair(a[e], b[e]), std::make_pair(b[e], a[e]) })
       {
-        const double c = r[p] + std::fabs(value[q] - value[p]) / 7.0 + 0.01 * step[e];
+        // The adjacency holds each step as a float.
+        const double c = r[p] + std::fabs(value[q] - value[p]) / 7.0 + 0.01 * static_cast<double>(static_cast<float>(step[e]));
         if (c < r[q])
         {
           r[q] = c;

@@ -24,13 +24,13 @@ constexpr std::int64_t CheckEvery = (std::int64_t(1) << 16) - 1;
 constexpr std::int64_t ConcurrentNodes = std::int64_t(1) << 20;
 
 // Neighbours of a node with the step to each: explicit edges as CSR (two passes, count then
-// insert) of 32-bit neighbour and edge ids and offsets (the cuts allow fewer than 2^31 nodes and
-// edge ends), the steps read from the graph's shared array; the grid's from the index.
+// insert) of 32-bit offsets and entries, each a neighbour id with its step as a float beside it (the
+// cuts allow fewer than 2^31 nodes and edge ends; read through the edge's id, the step was a cache
+// miss per relaxation); the grid's from the index.
 class Adjacency
 {
 public:
   Adjacency(const GraphEdges& edges, std::int64_t nodes, const SharedArray<double>& step)
-    : Step(step)
   {
     if (edges.IsGrid())
     {
@@ -49,19 +49,14 @@ public:
     {
       this->Offset[p + 1] += this->Offset[p];
     }
-    this->Neighbour.resize(2 * m);
-    this->Edge.resize(this->Step.empty() ? 0 : 2 * m);
+    this->Entry.assign(2 * m, Neighbour{ 0, 1.0f });
     std::vector<std::uint32_t> next(this->Offset.begin(), this->Offset.end() - 1);
     for (std::int64_t e = 0; e < m; ++e)
     {
       const std::int64_t a = edges.First()[e], b = edges.Second()[e];
-      if (!this->Edge.empty())
-      {
-        this->Edge[next[a]] = static_cast<std::uint32_t>(e);
-        this->Edge[next[b]] = static_cast<std::uint32_t>(e);
-      }
-      this->Neighbour[next[a]++] = static_cast<std::uint32_t>(b);
-      this->Neighbour[next[b]++] = static_cast<std::uint32_t>(a);
+      const float length = step.empty() ? 1.0f : static_cast<float>(step[e]);
+      this->Entry[next[a]++] = Neighbour{ static_cast<std::uint32_t>(b), length };
+      this->Entry[next[b]++] = Neighbour{ static_cast<std::uint32_t>(a), length };
     }
   }
 
@@ -81,17 +76,21 @@ public:
       if (k + 1 < this->Dims[2]) f(p + nxy, 1.0);
       return;
     }
-    const double* step = this->Step.data();
     for (std::uint32_t s = this->Offset[p]; s < this->Offset[p + 1]; ++s)
     {
-      f(static_cast<std::int64_t>(this->Neighbour[s]), step ? step[this->Edge[s]] : 1.0);
+      f(static_cast<std::int64_t>(this->Entry[s].Node), static_cast<double>(this->Entry[s].Step));
     }
   }
 
 private:
   std::array<std::int64_t, 3> Dims{ { 0, 0, 0 } };
-  std::vector<std::uint32_t> Offset, Neighbour, Edge;
-  SharedArray<double> Step; // held: a kept adjacency outlives the problem it was made for
+  struct Neighbour
+  {
+    std::uint32_t Node;
+    float Step;
+  };
+  std::vector<std::uint32_t> Offset;
+  std::vector<Neighbour> Entry;
 };
 
 // A path of length d at p extended to its neighbour q: the intensity step in units of the range,
@@ -177,13 +176,11 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   // pop a node before its last improvement; it is then pushed and expanded again, so the
   // distances stay exact.
   auto key = [](double d, std::int64_t p) {
-    float f = static_cast<float>(d);
-    if (static_cast<double>(f) < d)
-    {
-      f = std::nextafter(f, std::numeric_limits<float>::infinity());
-    }
+    const float f = static_cast<float>(d);
     std::uint32_t bits;
     std::memcpy(&bits, &f, sizeof bits);
+    // The next float up is the next bit pattern (d >= 0; a float never rounds below FLT_MAX's).
+    bits += static_cast<double>(f) < d ? 1u : 0u;
     return (static_cast<std::uint64_t>(bits) << 32) | static_cast<std::uint64_t>(p);
   };
   RadixHeap heap;

@@ -41,9 +41,10 @@ struct GeodesicGraph
 };
 
 // Geodesic distance of every node from the nodes with hard[p] == seedKind (infinity where none is
-// reachable), edge length |dValue| / scale + lengthWeight * step. Dijkstra on a radix heap of
-// 8-byte entries; for explicit edges a CSR adjacency of 32-bit ids is built first (fewer than
-// 2^31 nodes and edge ends, as the cuts require). Empty when progress asks to abort.
+// reachable), edge length |dValue| / scale + lengthWeight * step, the step rounded to a float.
+// Dijkstra on a radix heap of 8-byte entries; for explicit edges a CSR adjacency of 32-bit ids is
+// built first (fewer than 2^31 nodes and edge ends, as the cuts require), each neighbour's id with
+// its step. Empty when progress asks to abort.
 std::vector<double> GeodesicDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
   std::uint8_t seedKind, double scale, double lengthWeight, const ProgressFunction& progress = NoProgress());
 
