@@ -1,7 +1,7 @@
 """Multi-label segmentation (pvpython): k objects from labelled seeds, side by side.
 
 usage: pvpython scripts/benchmark_multilabel.py [--cases a,b] [--no-voxel] [--no-peers]
-                                                [--out out/benchmark_multilabel]
+                                                [--cut ChannelModel=2,Lambda=0.3] [--out out/benchmark_multilabel]
 Each multi-label case (Data/multilabel, then the shared data's multilabel/) runs the main job's
 pipeline: Feature Nodes -> Delaunay Image Mesh -> Image Mesh Smoothing on the first channel, then
 the Super-Voxel Cut with the labelled seeds (seeds.csv straight from the CSV reader) and every
@@ -130,7 +130,7 @@ def run_case(name, folder, args, tmp):
     mesh = case.mesh()
     mesh.UpdatePipeline()
     out["seconds"]["mesh"] = time.perf_counter() - t
-    cut = case.super_voxel_cut(mesh, SuperVoxelIds=1)
+    cut = case.super_voxel_cut(mesh, SuperVoxelIds=1, **args.cut)
     t = time.perf_counter()
     cut.UpdatePipeline()
     out["seconds"]["supervoxel"] = time.perf_counter() - t
@@ -169,7 +169,7 @@ def run_case(name, folder, args, tmp):
     out["seconds"]["binary"] = time.perf_counter() - t
 
     if not args.no_voxel:
-        voxel = case.voxel_cut()
+        voxel = case.voxel_cut(**args.cut)
         t = time.perf_counter()
         voxel.UpdatePipeline()
         out["seconds"]["voxel"] = time.perf_counter() - t
@@ -192,6 +192,7 @@ def main():
     ap.add_argument("--cases", default="")
     ap.add_argument("--no-voxel", action="store_true")
     ap.add_argument("--no-peers", action="store_true")
+    ap.add_argument("--cut", default="", type=fm.parse_properties, help="properties of both cuts, e.g. ChannelModel=2")
     ap.add_argument("--out", default=os.path.join(fm.ROOT, "out", "benchmark_multilabel"))
     args = ap.parse_args()
     fm.load_plugin()

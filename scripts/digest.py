@@ -87,8 +87,7 @@ def main():
     ap.add_argument("--cut", default="", help="cut properties, e.g. Lambda=1,Connectivity=0")
     ap.add_argument("--surface", default="", help="Segmentation Surface Smoothing properties, e.g. Method=0,Iterations=3")
     args = ap.parse_args()
-    cut_properties, surface_properties = ({k: int(v) if v.isdigit() else float(v) for k, v in (p.split("=") for p in text.split(",") if p)}
-                                          for text in (args.cut, args.surface))
+    cut_properties, surface_properties = fm.parse_properties(args.cut), fm.parse_properties(args.surface)
     fm.load_plugin()
     lines = []
     for name, d in fm.cases(args.cases).items():

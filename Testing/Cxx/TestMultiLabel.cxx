@@ -393,8 +393,8 @@ TEST(MultiLabel, AGaussianMixtureFindsItsComponents)
   EXPECT_NEAR(g.Mean[2 * b + 1], 40.0, 0.1);
   EXPECT_GT(g.Covariance[4 * a + 1], 4.0); // cov(x, y) = 6 in the first, -3 in the second
   EXPECT_LT(g.Covariance[4 * b + 1], -2.0);
-  const double atMean[2] = { 16.0, 20.0 }, between[2] = { 30.0, 30.0 };
-  EXPECT_GT(g.Density(atMean), 100.0 * g.Density(between));
+  const std::vector<double> density = g.Densities({ 16.0, 20.0, 30.0, 30.0 }); // a mean, and between the two
+  EXPECT_GT(density[0], 100.0 * density[1]);
   EXPECT_EQ(FitGaussianMixture(points, std::vector<double>(per * per, 0.0), 2, 4, { 1.0, 1.0 }).Components(), 0);
 }
 

@@ -184,6 +184,11 @@ def labels(cut, port=2):
     return v2n(fetch(cut, port).GetPointData().GetScalars())
 
 
+def parse_properties(text):
+    """{name: number} from "Lambda=1,Connectivity=0" (a script's --cut or --surface argument)."""
+    return {k: int(v) if v.lstrip("-").isdigit() else float(v) for k, v in (p.split("=") for p in text.split(",") if p)}
+
+
 def dice(a, b):
     a, b = np.asarray(a).astype(bool), np.asarray(b).astype(bool)
     return 2.0 * (a & b).sum() / max(1, a.sum() + b.sum())

@@ -15,7 +15,7 @@ using Matrix = Eigen::MatrixXd;
 using Vector = Eigen::VectorXd;
 
 constexpr int MaxIterations = 200;
-constexpr double Tolerance = 1e-8; // relative change of the log-likelihood that ends EM
+constexpr double Tolerance = 1e-7; // relative change of the log-likelihood that ends EM
 const double Log2Pi = std::log(2.0 * 3.14159265358979323846);
 
 struct Component
@@ -54,31 +54,53 @@ Component Moments(const std::vector<Vector>& x, const std::vector<double>& w, co
   return c;
 }
 
-// Per component: log of its weight times its normalising constant, and the Cholesky factor.
+// Per component: log of its weight times its normalising constant, and the inverse of its
+// covariance's Cholesky factor (row-major, d x d): the log-density is LogScale - |Inverse (x - mean)|^2 / 2.
 struct Prepared
 {
   double LogScale = 0.0;
-  Eigen::LLT<Matrix> Factor;
+  std::vector<double> Inverse, Mean;
 };
 
 Prepared Prepare(const Component& c, double total)
 {
+  const int d = static_cast<int>(c.Mean.size());
   Prepared p;
-  p.Factor.compute(c.Covariance);
-  const Matrix& l = p.Factor.matrixLLT();
+  const Eigen::LLT<Matrix> factor(c.Covariance);
+  const Matrix l = factor.matrixL();
   double logDet = 0.0;
-  for (int i = 0; i < l.rows(); ++i)
+  for (int i = 0; i < d; ++i)
   {
     logDet += 2.0 * std::log(l(i, i));
   }
-  p.LogScale = std::log(c.Weight / total) - 0.5 * (static_cast<double>(l.rows()) * Log2Pi + logDet);
+  const Matrix inverse = l.triangularView<Eigen::Lower>().solve(Matrix::Identity(d, d));
+  p.Inverse.resize(d * d);
+  for (int i = 0; i < d; ++i)
+  {
+    for (int j = 0; j < d; ++j)
+    {
+      p.Inverse[i * d + j] = inverse(i, j);
+    }
+  }
+  p.Mean.assign(c.Mean.data(), c.Mean.data() + d);
+  p.LogScale = std::log(c.Weight / total) - 0.5 * (static_cast<double>(d) * Log2Pi + logDet);
   return p;
 }
 
-double LogComponent(const Prepared& p, const Component& c, const Vector& x)
+double LogComponent(const Prepared& p, const double* x)
 {
-  const Vector z = p.Factor.matrixL().solve(x - c.Mean);
-  return p.LogScale - 0.5 * z.squaredNorm();
+  const int d = static_cast<int>(p.Mean.size());
+  double q = 0.0;
+  for (int i = 0; i < d; ++i)
+  {
+    double z = 0.0;
+    for (int j = 0; j <= i; ++j)
+    {
+      z += p.Inverse[i * d + j] * (x[j] - p.Mean[j]);
+    }
+    q += z * z;
+  }
+  return p.LogScale - 0.5 * q;
 }
 
 // EM from `components`; returns the weighted log-likelihood.
@@ -105,7 +127,7 @@ double Expectation(const std::vector<Vector>& x, const std::vector<double>& w, c
       double top = -std::numeric_limits<double>::infinity();
       for (std::size_t j = 0; j < k; ++j)
       {
-        resp[i * k + j] = LogComponent(prepared[j], components[j], x[i]);
+        resp[i * k + j] = LogComponent(prepared[j], x[i].data());
         top = std::max(top, resp[i * k + j]);
       }
       double sum = 0.0;
@@ -173,23 +195,27 @@ std::vector<Component> Start(const std::vector<Vector>& x, const std::vector<dou
 }
 } // namespace
 
-double GaussianMixture::Density(const double* x) const
+std::vector<double> GaussianMixture::Densities(const std::vector<double>& points) const
 {
   const int d = this->Dimensions;
-  double sum = 0.0;
+  std::vector<Prepared> prepared;
   for (int j = 0; j < this->Components(); ++j)
   {
-    const Eigen::Map<const Matrix> cov(this->Covariance.data() + j * d * d, d, d);
-    const Eigen::Map<const Vector> mean(this->Mean.data() + j * d, d);
-    const Eigen::Map<const Vector> at(x, d);
     Component c;
     c.Weight = this->Weight[j];
-    c.Mean = mean;
-    c.Covariance = cov;
-    const Prepared p = Prepare(c, 1.0);
-    sum += std::exp(LogComponent(p, c, at));
+    c.Mean = Eigen::Map<const Vector>(this->Mean.data() + j * d, d);
+    c.Covariance = Eigen::Map<const Matrix>(this->Covariance.data() + j * d * d, d, d);
+    prepared.push_back(Prepare(c, 1.0));
   }
-  return sum;
+  std::vector<double> density(d > 0 ? points.size() / d : 0, 0.0);
+  for (std::size_t i = 0; i < density.size(); ++i)
+  {
+    for (const Prepared& p : prepared)
+    {
+      density[i] += std::exp(LogComponent(p, points.data() + i * d));
+    }
+  }
+  return density;
 }
 
 GaussianMixture FitGaussianMixture(const std::vector<double>& points, const std::vector<double>& weight, int dimensions,

@@ -16,8 +16,8 @@ struct GaussianMixture
   std::vector<double> Covariance; // component x dimension x dimension
 
   int Components() const { return static_cast<int>(this->Weight.size()); }
-  // The density at x (Dimensions values).
-  double Density(const double* x) const;
+  // The density at each point of `points` (count x Dimensions).
+  std::vector<double> Densities(const std::vector<double>& points) const;
 };
 
 // The mixture of 1..maxComponents components with the lowest BIC for `points` (count x dimensions)

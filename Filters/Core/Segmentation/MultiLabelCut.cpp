@@ -581,12 +581,7 @@ std::vector<std::vector<double>> LabelCosts(const std::vector<std::vector<double
         reg[c] = h * h;
       }
       const GaussianMixture mixture = FitGaussianMixture(points, count, n, MixtureComponents, reg);
-      std::vector<double> density(count.size(), 0.0);
-      for (std::size_t b = 0; b < count.size() && mixture.Components() > 0; ++b)
-      {
-        density[b] = mixture.Density(points.data() + b * n);
-      }
-      cost.push_back(NegativeLog(std::move(density)));
+      cost.push_back(NegativeLog(mixture.Densities(points)));
       continue;
     }
     if (model == ChannelModel::Joint || n == 1)
