@@ -1751,11 +1751,14 @@ void LabelledCut(vtkImageData* image, vtkDataObject* seeds, const Check& check,
 }
 
 template <typename Check>
-void LabelledVoxelCut(vtkImageData* image, vtkDataObject* seeds, const Check& check)
+void LabelledVoxelCut(vtkImageData* image, vtkDataObject* seeds, const Check& check,
+  const std::function<void(vtkVoxelCut*)>& set = nullptr)
 {
   Run<vtkVoxelCut> cut;
   cut->SetInputData(0, image);
   cut->SetInputData(3, seeds);
+  if (set)
+    set(cut.F);
   cut.Update();
   check(cut, cut->GetOutput());
 }
@@ -1837,6 +1840,16 @@ TEST(SuperVoxelCut, TwoChannels)
   auto image = TwoDiscs(2);
   LabelledCut(image, LabelledPoints(image, ThreeLabels()),
     [&](auto& cut, const CutOutputs& out) { ExpectLabelled(cut, out.Labels, image, ThreeLabels()); });
+}
+TEST(SuperVoxelCut, EveryChannelModel)
+{
+  // Joint, Independent, Gaussian Mixture; beyond the enumeration the setter clamps (to 0 or 2).
+  auto image = TwoDiscs(2);
+  for (int model : { 0, 1, 2, -3, 7 })
+    LabelledCut(image, LabelledPoints(image, ThreeLabels()), [&](auto& cut, const CutOutputs& out) {
+      EXPECT_EQ(cut->GetChannelModel(), model < 0 ? 0 : std::min(model, 2));
+      ExpectLabelled(cut, out.Labels, image, ThreeLabels());
+    }, [&](vtkSuperVoxelCut* f) { f->SetChannelModel(model); });
 }
 TEST(SuperVoxelCut, NaNInOneChannel)
 {
@@ -1925,6 +1938,13 @@ TEST(VoxelCut, LabelledSeedsTwoChannels)
 {
   auto image = TwoDiscs(2);
   LabelledVoxelCut(image, LabelledPoints(image, ThreeLabels()), [&](auto& cut, vtkImageData* out) { ExpectLabelled(cut, out, image, ThreeLabels()); });
+}
+TEST(VoxelCut, GaussianMixtureChannelModel)
+{
+  auto image = TwoDiscs(2);
+  LabelledVoxelCut(image, LabelledPoints(image, ThreeLabels()),
+    [&](auto& cut, vtkImageData* out) { ExpectLabelled(cut, out, image, ThreeLabels()); },
+    [](vtkVoxelCut* f) { f->SetChannelModel(2); });
 }
 TEST(VoxelCut, NaNInOneChannel)
 {
