@@ -23,10 +23,11 @@ constexpr std::int64_t CheckEvery = (std::int64_t(1) << 16) - 1;
 // after the other, reporting progress.
 constexpr std::int64_t ConcurrentNodes = std::int64_t(1) << 20;
 
-// Neighbours of a node with the step to each: explicit edges as CSR (two passes, count then
-// insert) of 32-bit offsets and entries, each a neighbour id with its step as a float beside it (the
-// cuts allow fewer than 2^31 nodes and edge ends; read through the edge's id, the step was a cache
-// miss per relaxation); the grid's from the index.
+// Neighbours of a node with the step to each, each entry a 32-bit neighbour id with its step as a
+// float beside it (the cuts allow fewer than 2^31 nodes and edge ends): for explicit edges with at
+// most four per node (a mesh's face neighbours) four slots per node in a 32-byte block, so a node's
+// neighbours are one cache miss (Dijkstra pops nodes all over the graph); else CSR (two passes,
+// count then insert); the grid's from the index. Either way in the order of the edges.
 class Adjacency
 {
 public:
@@ -39,32 +40,51 @@ public:
       return;
     }
     const std::int64_t m = edges.Size();
-    this->Offset.assign(nodes + 1, 0);
+    std::vector<std::uint32_t> degree(nodes + 1, 0);
     for (std::int64_t e = 0; e < m; ++e)
     {
-      ++this->Offset[edges.First()[e] + 1];
-      ++this->Offset[edges.Second()[e] + 1];
+      ++degree[edges.First()[e] + 1];
+      ++degree[edges.Second()[e] + 1];
     }
-    for (std::int64_t p = 0; p < nodes; ++p)
+    const bool blocks = *std::max_element(degree.begin(), degree.end()) <= Slots;
+    if (blocks)
     {
-      this->Offset[p + 1] += this->Offset[p];
+      // Aligned to the block: a block never straddles two cache lines.
+      this->Storage.assign(Slots * nodes + Slots, Neighbour{ None, 0.0f });
+      const auto address = reinterpret_cast<std::uintptr_t>(this->Storage.data());
+      this->First = (Slots - (address / sizeof(Neighbour)) % Slots) % Slots;
+      std::fill(degree.begin(), degree.end(), 0);
+      for (std::int64_t p = 0; p < nodes; ++p)
+      {
+        degree[p] = static_cast<std::uint32_t>(Slots * p);
+      }
     }
-    this->Entry.assign(2 * m, Neighbour{ 0, 1.0f });
-    std::vector<std::uint32_t> next(this->Offset.begin(), this->Offset.end() - 1);
+    else
+    {
+      for (std::int64_t p = 0; p < nodes; ++p)
+      {
+        degree[p + 1] += degree[p];
+      }
+      this->Offset = degree;
+      this->Storage.assign(2 * m, Neighbour{ 0, 1.0f });
+    }
+    std::vector<std::uint32_t>& next = degree; // each node's next free entry
+    Neighbour* entry = this->Storage.data() + this->First;
     for (std::int64_t e = 0; e < m; ++e)
     {
       const std::int64_t a = edges.First()[e], b = edges.Second()[e];
       const float length = step.empty() ? 1.0f : static_cast<float>(step[e]);
-      this->Entry[next[a]++] = Neighbour{ static_cast<std::uint32_t>(b), length };
-      this->Entry[next[b]++] = Neighbour{ static_cast<std::uint32_t>(a), length };
+      entry[next[a]++] = Neighbour{ static_cast<std::uint32_t>(b), length };
+      entry[next[b]++] = Neighbour{ static_cast<std::uint32_t>(a), length };
     }
+    this->Explicit = true;
   }
 
   // f(q, step) for every neighbour q of p.
   template <typename F>
   void ForEach(std::int64_t p, F&& f) const
   {
-    if (this->Offset.empty())
+    if (!this->Explicit)
     {
       const std::int64_t nx = this->Dims[0], ny = this->Dims[1], nxy = nx * ny;
       const std::int64_t i = p % nx, j = (p / nx) % ny, k = p / nxy;
@@ -76,21 +96,35 @@ public:
       if (k + 1 < this->Dims[2]) f(p + nxy, 1.0);
       return;
     }
+    const Neighbour* entry = this->Storage.data() + this->First;
+    if (this->Offset.empty())
+    {
+      const Neighbour* block = entry + Slots * p;
+      for (int s = 0; s < Slots && block[s].Node != None; ++s)
+      {
+        f(static_cast<std::int64_t>(block[s].Node), static_cast<double>(block[s].Step));
+      }
+      return;
+    }
     for (std::uint32_t s = this->Offset[p]; s < this->Offset[p + 1]; ++s)
     {
-      f(static_cast<std::int64_t>(this->Entry[s].Node), static_cast<double>(this->Entry[s].Step));
+      f(static_cast<std::int64_t>(entry[s].Node), static_cast<double>(entry[s].Step));
     }
   }
 
 private:
-  std::array<std::int64_t, 3> Dims{ { 0, 0, 0 } };
+  static constexpr int Slots = 4;
+  static constexpr std::uint32_t None = 0xffffffffu;
   struct Neighbour
   {
     std::uint32_t Node;
     float Step;
   };
-  std::vector<std::uint32_t> Offset;
-  std::vector<Neighbour> Entry;
+  std::array<std::int64_t, 3> Dims{ { 0, 0, 0 } };
+  bool Explicit = false;
+  std::vector<std::uint32_t> Offset; // CSR; empty with blocks of Slots
+  std::vector<Neighbour> Storage;
+  std::size_t First = 0; // the first entry in Storage
 };
 
 // A path of length d at p extended to its neighbour q: the intensity step in units of the range,
