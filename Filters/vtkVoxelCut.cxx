@@ -116,7 +116,7 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     }
     this->UpdateProgress(0.2);
     const CutResult cut = featuremesh::VoxelCut(
-      std::move(values), geometry, objectVoxels, backgroundVoxels, par, AlgorithmProgress(this, 0.2, 0.95));
+      std::move(values), geometry, objectVoxels, backgroundVoxels, par, AlgorithmProgress(this, 0.2, 0.95), SMPParallelFor());
     if (cut.Aborted || !cut.Error.empty())
     {
       return cut.Aborted ? 1 : this->Fail(cut.Error);
@@ -159,7 +159,7 @@ int vtkVoxelCut::RequestMultiLabel(const featuremesh::LabelledSeeds& seeds, vtkD
   this->UpdateProgress(0.2);
   const MultiLabelParameters& multi = *this;
   const MultiLabelResult result =
-    MultiLabelVoxelCut(values, bins, geometry, seeds, par, multi, AlgorithmProgress(this, 0.2, 0.95));
+    MultiLabelVoxelCut(values, bins, geometry, seeds, par, multi, AlgorithmProgress(this, 0.2, 0.95), SMPParallelFor());
   if (result.Aborted || !result.Error.empty())
   {
     return result.Aborted ? 1 : this->Fail(result.Error);

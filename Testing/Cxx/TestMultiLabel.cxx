@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -358,6 +360,41 @@ TEST(MultiLabel, TheSecondChannelTellsTheLabelsApart)
   Lattice m;
   ASSERT_TRUE(m.Make(g, first, 1));
   EXPECT_LT(p.Correct(m.Cut(p.Seeds, sp)), 0.8);
+}
+
+TEST(MultiLabel, LargeGraphsRunTheirKindsFromAHelperThread)
+{
+  // A grid over 2^20 nodes (the voxel cut's graphs): three kinds run from a helper thread on two
+  // threads give each kind's own distances; progress comes on this thread and rises; an abort
+  // comes back at once as empty distances.
+  const int nx = 128, ny = 128, nz = 66;
+  const GraphEdges grid = GraphEdges::Grid(nx, ny, nz);
+  std::vector<double> value(static_cast<std::size_t>(nx) * ny * nz);
+  for (std::size_t v = 0; v < value.size(); ++v)
+    value[v] = static_cast<double>((v * 2654435761u) % 97);
+  GeodesicGraph graph;
+  graph.Edges = &grid;
+  graph.Value = value;
+  std::vector<std::uint8_t> hard(value.size(), 0);
+  hard[5] = 1;
+  hard[value.size() / 2] = 2;
+  hard[value.size() - 7] = 3;
+  const std::thread::id here = std::this_thread::get_id();
+  std::vector<double> reported;
+  bool elsewhere = false;
+  const std::vector<std::vector<double>> d = SeedKindDistances(graph, hard, 3, 97.0, 0.01, [&](double t) {
+    elsewhere = elsewhere || std::this_thread::get_id() != here;
+    reported.push_back(t);
+    return true;
+  }, nullptr, TwoThreads);
+  ASSERT_EQ(d.size(), 3u);
+  EXPECT_FALSE(elsewhere);
+  EXPECT_TRUE(std::is_sorted(reported.begin(), reported.end()));
+  for (int kind = 1; kind <= 3; ++kind)
+    EXPECT_EQ(d[kind - 1], GeodesicDistances(graph, hard, static_cast<std::uint8_t>(kind), 97.0, 0.01)) << "kind " << kind;
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_TRUE(SeedKindDistances(graph, hard, 3, 97.0, 0.01, [](double) { return false; }, nullptr, TwoThreads).empty());
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
 }
 
 TEST(MultiLabel, AGaussianMixtureFindsItsComponents)

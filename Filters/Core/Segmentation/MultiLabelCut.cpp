@@ -872,7 +872,7 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
 
 MultiLabelResult MultiLabelVoxelCut(const std::vector<double>& values, const ChannelBins& bins, const ImageGeometry& g,
   const LabelledSeeds& seeds, const VoxelCutParameters& par, const MultiLabelParameters& multi,
-  const ProgressFunction& progress)
+  const ProgressFunction& progress, const ParallelFor& parallel)
 {
   const auto t0 = Clock::now();
   MultiLabelResult r;
@@ -906,7 +906,7 @@ MultiLabelResult MultiLabelVoxelCut(const std::vector<double>& values, const Cha
       pr.Cost[v * L + l] = par.Lambda * costs[l][bins.Bin[v]];
     }
   }
-  SolveLabels(pr, hard, values, bins, {}, {}, {}, BorderVoxels(g), par, multi, {}, SerialFor(), progress, nullptr, t0, r);
+  SolveLabels(pr, hard, values, bins, {}, {}, {}, BorderVoxels(g), par, multi, {}, parallel, progress, nullptr, t0, r);
   return r;
 }
 } // namespace featuremesh

@@ -156,7 +156,8 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
 // the voxels within SeedRadius of each seed.
 MultiLabelResult MultiLabelVoxelCut(const std::vector<double>& values, const ChannelBins& bins,
   const ImageGeometry& geometry, const LabelledSeeds& seeds, const VoxelCutParameters& parameters,
-  const MultiLabelParameters& multi, const ProgressFunction& progress = NoProgress());
+  const MultiLabelParameters& multi, const ProgressFunction& progress = NoProgress(),
+  const ParallelFor& parallel = SerialFor());
 
 // The connectivity rule per label, in place: with Seeded Object a component of an object label that
 // holds none of that label's seeds, and with either rule a background component that holds no

@@ -2,14 +2,20 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <functional>
 #include <iterator>
 #include <memory>
+#include <mutex>
 #include <limits>
 #include <queue>
 #include <string>
+#include <thread>
 #include <utility>
 
 namespace featuremesh
@@ -18,9 +24,9 @@ namespace
 {
 // Pops between progress checks.
 constexpr std::int64_t CheckEvery = (std::int64_t(1) << 16) - 1;
-// Graphs up to this many nodes run both seed kinds at once on two threads, without a progress report
-// (a whole run over BraTS's 266 k elements takes ~0.05 s here); larger ones (voxel grids) one
-// after the other, reporting progress.
+// Graphs up to this many nodes run their seed kinds at once without a progress report (a whole run
+// over BraTS's 266 k elements takes ~0.05 s here); larger ones (voxel grids) run from a helper
+// thread while the caller's reports progress.
 constexpr std::int64_t ConcurrentNodes = std::int64_t(1) << 20;
 
 // Neighbours of a node with the step to each, each entry a 32-bit neighbour id with its step as a
@@ -409,10 +415,73 @@ std::shared_ptr<SeedGeodesicCache::Kept> SeedGeodesicCache::Take(const GeodesicG
 
 namespace
 {
+// `run(i, progress)` for i in [0, count) on `parallel`'s threads, started from a helper thread while
+// this one reports the runs' mean progress every 50 ms over [0, 0.9] (VTK 9.2's STDThread backend
+// does not run a loop on the calling thread, so a run there could not report) and, when progress asks to
+// abort, makes every run's progress return false; false then. A run's progress is called on the
+// thread it runs on and must only record. What the runs throw is rethrown here.
+bool RunReportingHere(std::int64_t count, const ParallelFor& parallel, const ProgressFunction& progress,
+  const std::function<bool(std::int64_t, const ProgressFunction&)>& run)
+{
+  std::unique_ptr<std::atomic<double>[]> fraction(new std::atomic<double>[count]);
+  for (std::int64_t i = 0; i < count; ++i)
+  {
+    fraction[i] = 0.0;
+  }
+  std::atomic<bool> abort{ false };
+  std::mutex lock;
+  std::condition_variable done;
+  bool finished = false;
+  std::exception_ptr error;
+  std::thread helper([&]() {
+    try
+    {
+      parallel(count, 1, [&](std::int64_t b, std::int64_t e) {
+        for (std::int64_t i = b; i < e && !abort; ++i)
+        {
+          run(i, [&, i](double t) {
+            fraction[i] = t;
+            return !abort;
+          });
+        }
+      });
+    }
+    catch (...)
+    {
+      error = std::current_exception();
+    }
+    std::lock_guard<std::mutex> guard(lock);
+    finished = true;
+    done.notify_all();
+  });
+  std::unique_lock<std::mutex> wait(lock);
+  while (!done.wait_for(wait, std::chrono::milliseconds(50), [&] { return finished; }))
+  {
+    wait.unlock();
+    double sum = 0.0;
+    for (std::int64_t i = 0; i < count; ++i)
+    {
+      sum += fraction[i];
+    }
+    if (!abort && !progress(0.9 * sum / static_cast<double>(count)))
+    {
+      abort = true;
+    }
+    wait.lock();
+  }
+  wait.unlock();
+  helper.join();
+  if (error)
+  {
+    std::rethrow_exception(error);
+  }
+  return !abort && progress(0.9);
+}
+
 // The kept distances of kinds 1..seeds.size() made exact for these seed nodes: kinds whose seeds
-// changed are updated side by side on `parallel`'s threads up to ConcurrentNodes nodes (progress
-// then reported after them only), one after the other beyond, over [0, 0.9] of progress. False
-// when progress asks to abort.
+// changed are updated side by side on `parallel`'s threads, over [0, 0.9] of progress. Up to
+// ConcurrentNodes nodes progress is reported after them only; beyond, they run from a helper
+// thread while this one reports progress (RunReportingHere). False when progress asks to abort.
 bool UpdateKinds(const GeodesicGraph& graph, std::vector<std::vector<std::int64_t>> seeds, double scale,
   double lengthWeight, const ParallelFor& parallel, const ProgressFunction& progress, SeedGeodesicCache::Kept& kept)
 {
@@ -424,7 +493,8 @@ bool UpdateKinds(const GeodesicGraph& graph, std::vector<std::vector<std::int64_
       update.push_back(k);
     }
   }
-  const auto run = [&](int k, const ProgressFunction& report) {
+  const auto run = [&](std::int64_t i, const ProgressFunction& report) {
+    const int k = update[i];
     return UpdateField(graph, *kept.Neighbours, kept.Seeds[k], seeds[k], scale, lengthWeight, kept.Field[k], report);
   };
   const std::int64_t count = static_cast<std::int64_t>(update.size());
@@ -433,7 +503,7 @@ bool UpdateKinds(const GeodesicGraph& graph, std::vector<std::vector<std::int64_
     parallel(count, 1, [&](std::int64_t i0, std::int64_t i1) {
       for (std::int64_t i = i0; i < i1; ++i)
       {
-        run(update[i], NoProgress());
+        run(i, NoProgress());
       }
     });
     if (!progress(0.9))
@@ -441,12 +511,9 @@ bool UpdateKinds(const GeodesicGraph& graph, std::vector<std::vector<std::int64_
       return false;
     }
   }
-  for (std::int64_t i = 0; i < count && graph.Nodes() > ConcurrentNodes; ++i)
+  else if (count > 0 && !RunReportingHere(count, parallel, progress, run))
   {
-    if (!run(update[i], SubProgress(progress, 0.9 * i / count, 0.9 * (i + 1) / count)))
-    {
-      return false;
-    }
+    return false;
   }
   for (std::size_t k = 0; k < seeds.size(); ++k)
   {

@@ -345,11 +345,12 @@ std::string ValidateParameters(const SeededCutParameters& p)
 
 CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
   const std::vector<std::int64_t>& objectVoxels, const std::vector<std::int64_t>& backgroundVoxels,
-  const VoxelCutParameters& parameters, const ProgressFunction& progress)
+  const VoxelCutParameters& parameters, const ProgressFunction& progress, const ParallelFor& parallel)
 {
   CutResult failed;
   const std::int64_t n = g.Size();
   CutProblem pr;
+  pr.Parallel = parallel;
   pr.Value = std::move(values);
   pr.Hard.assign(n, 0);
   for (std::int64_t v : objectVoxels)

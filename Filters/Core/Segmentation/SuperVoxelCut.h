@@ -167,10 +167,12 @@ bool PatchVoxelLabels(const SimplexMesh& mesh, const VoxelOwnerMap& owner, const
   const std::vector<std::uint8_t>& label, std::uint8_t* out, const ParallelFor& parallel);
 
 // The voxel cut on the 4-/6-connected grid, each neighbour pair one voxel face; `values` (one per
-// voxel) is moved in, not copied.
+// voxel) is moved in, not copied. Its loops run on `parallel` as the super-voxel cut's do (the
+// same labels for any thread count).
 CutResult VoxelCut(std::vector<double> values, const ImageGeometry& geometry,
   const std::vector<std::int64_t>& objectVoxels, const std::vector<std::int64_t>& backgroundVoxels,
-  const VoxelCutParameters& parameters, const ProgressFunction& progress = NoProgress());
+  const VoxelCutParameters& parameters, const ProgressFunction& progress = NoProgress(),
+  const ParallelFor& parallel = SerialFor());
 
 // Empty when usable, else a sentence.
 std::string ValidateParameters(const SeededCutParameters& p);
