@@ -4,15 +4,15 @@
 #include <array>
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cmath>
+#include <condition_variable>
 #include <cstring>
 #include <exception>
 #include <functional>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <mutex>
-#include <limits>
 #include <queue>
 #include <string>
 #include <thread>
@@ -52,38 +52,37 @@ public:
       ++degree[edges.First()[e] + 1];
       ++degree[edges.Second()[e] + 1];
     }
-    const bool blocks = *std::max_element(degree.begin(), degree.end()) <= Slots;
-    if (blocks)
+    this->Explicit = true;
+    const auto length = [&](std::int64_t e) { return step.empty() ? 1.0f : static_cast<float>(step[e]); };
+    if (*std::max_element(degree.begin(), degree.end()) <= Slots)
     {
       // Aligned to the block: a block never straddles two cache lines.
       this->Storage.assign(Slots * nodes + Slots, Neighbour{ None, 0.0f });
       const auto address = reinterpret_cast<std::uintptr_t>(this->Storage.data());
       this->First = (Slots - (address / sizeof(Neighbour)) % Slots) % Slots;
-      std::fill(degree.begin(), degree.end(), 0);
-      for (std::int64_t p = 0; p < nodes; ++p)
+      Neighbour* block = this->Storage.data() + this->First;
+      std::vector<std::uint8_t> filled(nodes, 0);
+      for (std::int64_t e = 0; e < m; ++e)
       {
-        degree[p] = static_cast<std::uint32_t>(Slots * p);
+        const std::int64_t a = edges.First()[e], b = edges.Second()[e];
+        block[Slots * a + filled[a]++] = Neighbour{ static_cast<std::uint32_t>(b), length(e) };
+        block[Slots * b + filled[b]++] = Neighbour{ static_cast<std::uint32_t>(a), length(e) };
       }
+      return;
     }
-    else
+    for (std::int64_t p = 0; p < nodes; ++p)
     {
-      for (std::int64_t p = 0; p < nodes; ++p)
-      {
-        degree[p + 1] += degree[p];
-      }
-      this->Offset = degree;
-      this->Storage.assign(2 * m, Neighbour{ 0, 1.0f });
+      degree[p + 1] += degree[p];
     }
+    this->Offset = degree;
+    this->Storage.resize(2 * m);
     std::vector<std::uint32_t>& next = degree; // each node's next free entry
-    Neighbour* entry = this->Storage.data() + this->First;
     for (std::int64_t e = 0; e < m; ++e)
     {
       const std::int64_t a = edges.First()[e], b = edges.Second()[e];
-      const float length = step.empty() ? 1.0f : static_cast<float>(step[e]);
-      entry[next[a]++] = Neighbour{ static_cast<std::uint32_t>(b), length };
-      entry[next[b]++] = Neighbour{ static_cast<std::uint32_t>(a), length };
+      this->Storage[next[a]++] = Neighbour{ static_cast<std::uint32_t>(b), length(e) };
+      this->Storage[next[b]++] = Neighbour{ static_cast<std::uint32_t>(a), length(e) };
     }
-    this->Explicit = true;
   }
 
   // f(q, step) for every neighbour q of p.
@@ -433,22 +432,35 @@ bool RunReportingHere(std::int64_t count, const ParallelFor& parallel, const Pro
   std::condition_variable done;
   bool finished = false;
   std::exception_ptr error;
+  const auto keep = [&](std::exception_ptr e) {
+    std::lock_guard<std::mutex> guard(lock);
+    error = error ? error : e;
+    abort = true;
+  };
   std::thread helper([&]() {
     try
     {
       parallel(count, 1, [&](std::int64_t b, std::int64_t e) {
         for (std::int64_t i = b; i < e && !abort; ++i)
         {
-          run(i, [&, i](double t) {
-            fraction[i] = t;
-            return !abort;
-          });
+          // Caught here: an exception must not leave a thread of the SMP backend.
+          try
+          {
+            run(i, [&, i](double t) {
+              fraction[i] = t;
+              return !abort;
+            });
+          }
+          catch (...)
+          {
+            keep(std::current_exception());
+          }
         }
       });
     }
     catch (...)
     {
-      error = std::current_exception();
+      keep(std::current_exception());
     }
     std::lock_guard<std::mutex> guard(lock);
     finished = true;
