@@ -918,6 +918,56 @@ TEST(SeedGeodesics, KeptDistancesEqualFreshOnes)
   }
 }
 
+TEST(SeedGeodesics, KeptDistancesAtANewScaleEqualFreshOnes)
+{
+  // The intensity unit moves from cut to cut (a seed sample beyond the histogram's range widens it),
+  // with and without seed edits: the kept distances, summed again along their paths and repaired
+  // where an edge now shortens them, equal those computed afresh at that scale.
+  ImageGeometry g = Grid2(40, 30);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<double> value(g.Size());
+  for (int j = 0; j < 30; ++j)
+    for (int i = 0; i < 40; ++i)
+      value[g.Index(i, j, 0)] = (std::hypot(i - 15, j - 15) < 9 ? 50.0 : 10.0) + 5.0 * u(rng);
+  std::vector<std::int64_t> a, b;
+  std::vector<double> step;
+  GraphEdges::Grid(40, 30, 1).ForEach([&](std::int64_t, std::int64_t p, std::int64_t q) {
+    a.push_back(p);
+    b.push_back(q);
+    step.push_back(0.5 + u(rng));
+  });
+  const GraphEdges edges(a, b);
+  GeodesicGraph graph;
+  graph.Edges = &edges;
+  graph.Value = value;
+  graph.Step = step;
+  const double scales[] = { 40.0, 44.0, 44.0, 30.0, 400.0, 4.0, 40.0 };
+  const std::vector<std::vector<std::int64_t>> object = { { g.Index(15, 15, 0) }, { g.Index(15, 15, 0) },
+    { g.Index(12, 18, 0) }, { g.Index(12, 18, 0), g.Index(18, 12, 0) }, { g.Index(18, 12, 0) }, { g.Index(18, 12, 0) },
+    { g.Index(16, 16, 0) } };
+  const std::vector<std::vector<std::int64_t>> background = { { g.Index(1, 1, 0) }, { g.Index(1, 1, 0) },
+    { g.Index(1, 1, 0), g.Index(38, 28, 0) }, { g.Index(38, 28, 0) }, { g.Index(38, 28, 0) }, { g.Index(2, 1, 0) },
+    { g.Index(39, 29, 0), g.Index(0, 29, 0) } };
+  SeedGeodesicCache cache;
+  for (std::size_t edit = 0; edit < object.size(); ++edit)
+  {
+    std::vector<std::uint8_t> hard(g.Size(), 0);
+    for (std::int64_t v : object[edit])
+      hard[v] = 1;
+    for (std::int64_t v : background[edit])
+      hard[v] = 2;
+    const std::vector<std::vector<double>> kept = SeedKindDistances(graph, hard, 2, scales[edit], 0.01, NoProgress(), &cache);
+    ASSERT_EQ(kept.size(), 2u);
+    for (int kind : { 1, 2 })
+    {
+      const std::vector<double> fresh = GeodesicDistances(graph, hard, static_cast<std::uint8_t>(kind), scales[edit], 0.01);
+      for (std::size_t v = 0; v < fresh.size(); ++v)
+        ASSERT_NEAR(kept[kind - 1][v], fresh[v], 1e-12 * (1.0 + fresh[v])) << "edit " << edit << " kind " << kind << " node " << v;
+    }
+  }
+}
+
 TEST(SeedGeodesics, DijkstraMatchesBellmanFord)
 {
   // A random graph with random values, steps and seeds, and a plateau where many paths tie: the

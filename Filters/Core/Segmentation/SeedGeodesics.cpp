@@ -191,7 +191,9 @@ private:
 struct DistanceField
 {
   std::vector<double> Distance;
-  std::vector<std::int32_t> Root; // -1 unreachable (fewer than 2^31 nodes)
+  std::vector<std::int32_t> Root;   // -1 unreachable (fewer than 2^31 nodes)
+  std::vector<std::int32_t> Parent; // the previous node on the path; -1 at seeds and unreachable
+  double Scale = 0.0;               // the intensity unit the distances are in
 };
 
 // Dijkstra into `field` from `seeds` (distance 0) and from `start` (nodes whose distances `field`
@@ -208,7 +210,9 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   {
     field.Distance.assign(n, std::numeric_limits<double>::infinity());
     field.Root.assign(n, -1);
+    field.Parent.assign(n, -1);
   }
+  field.Scale = scale;
   std::vector<double>& distance = field.Distance;
   // Heap entries of 8 bytes: the distance rounded up to a float (non-negative floats order as
   // their bits, and a longer path never rounds to a smaller key) above the node. Equal keys may
@@ -227,6 +231,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   {
     distance[p] = 0.0;
     field.Root[p] = static_cast<std::int32_t>(p);
+    field.Parent[p] = -1;
     heap.Push(key(0.0, p));
   }
   for (std::int64_t p : start)
@@ -255,6 +260,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
       {
         distance[q] = candidate;
         field.Root[q] = root;
+        field.Parent[q] = static_cast<std::int32_t>(p);
         heap.Push(key(candidate, q));
       }
     });
@@ -262,13 +268,87 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   return true;
 }
 
-// `field` (exact for the sorted seed nodes `before`, or empty) made exact for `after`: nodes whose
-// path started at a removed seed start again from their neighbours that kept theirs (removing seeds
-// cannot shorten any other path), added seeds start at 0.
+// `field` (exact at field.Scale) made exact at `scale` for the same seeds. Each node's distance is
+// first summed again along its kept path, edge by edge as Dijkstra sums it: an upper bound, exact
+// where the path stays shortest. Then every node that some edge now shortens starts Dijkstra.
+// False when progress asks to abort. Paths are acyclic (a node's previous node is set only when
+// it strictly shortens its distance); should one not be, the field is emptied, to start afresh.
+bool Rescale(const GeodesicGraph& g, const Adjacency& adjacency, double scale, double lengthWeight,
+  DistanceField& field, const ProgressFunction& progress)
+{
+  const std::int64_t n = g.Nodes();
+  const double* value = g.Value.data();
+  const double inverse = 1.0 / scale;
+  std::vector<double> distance(n, std::numeric_limits<double>::quiet_NaN());
+  std::vector<std::int64_t> path;
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    // Up the kept path to a node already done, or to its seed; then down, summing.
+    std::int64_t q = p;
+    while (std::isnan(distance[q]) && field.Parent[q] >= 0)
+    {
+      path.push_back(q);
+      q = field.Parent[q];
+      if (static_cast<std::int64_t>(path.size()) > n)
+      {
+        field = DistanceField();
+        return true;
+      }
+    }
+    if (std::isnan(distance[q]))
+    {
+      distance[q] = std::isfinite(field.Distance[q]) ? 0.0 : std::numeric_limits<double>::infinity();
+    }
+    for (auto c = path.rbegin(); c != path.rend(); ++c)
+    {
+      const std::int64_t from = field.Parent[*c];
+      double step = std::numeric_limits<double>::infinity();
+      adjacency.ForEach(from, [&](std::int64_t r, double s) { step = r == *c ? std::min(step, s) : step; });
+      distance[*c] = Extended(distance[from], value, from, *c, step, inverse, lengthWeight);
+    }
+    path.clear();
+  }
+  field.Distance.swap(distance);
+  std::vector<std::int64_t> start;
+  std::vector<std::uint8_t> queued(n, 0);
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    const double d = field.Distance[p];
+    if (!std::isfinite(d))
+    {
+      continue;
+    }
+    adjacency.ForEach(p, [&](std::int64_t q, double step) {
+      const double candidate = Extended(d, value, p, q, step, inverse, lengthWeight);
+      if (candidate < field.Distance[q])
+      {
+        field.Distance[q] = candidate;
+        field.Root[q] = field.Root[p];
+        field.Parent[q] = static_cast<std::int32_t>(p);
+        if (!queued[q])
+        {
+          queued[q] = 1;
+          start.push_back(q);
+        }
+      }
+    });
+  }
+  return Dijkstra(g, adjacency, {}, start, scale, lengthWeight, field, progress);
+}
+
+// `field` (exact for the sorted seed nodes `before` at field.Scale, or empty) made exact for `after`
+// at `scale`: a new scale first (Rescale); then nodes whose path started at a removed seed start
+// again from their neighbours that kept theirs (removing seeds cannot shorten any other path),
+// added seeds start at 0.
 bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::vector<std::int64_t>& before,
   const std::vector<std::int64_t>& after, double scale, double lengthWeight, DistanceField& field,
   const ProgressFunction& progress)
 {
+  if (!field.Distance.empty() && field.Scale != scale &&
+    !Rescale(g, adjacency, scale, lengthWeight, field, SubProgress(progress, 0.0, 0.5)))
+  {
+    return false;
+  }
   if (field.Distance.empty())
   {
     return Dijkstra(g, adjacency, after, {}, scale, lengthWeight, field, progress);
@@ -290,6 +370,7 @@ bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::
       {
         field.Distance[p] = std::numeric_limits<double>::infinity();
         field.Root[p] = -1;
+        field.Parent[p] = -1;
         orphans.push_back(p);
       }
     }
@@ -305,6 +386,7 @@ bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::
           {
             field.Distance[p] = candidate;
             field.Root[p] = field.Root[q];
+            field.Parent[p] = static_cast<std::int32_t>(q);
           }
         }
       });
@@ -340,8 +422,9 @@ struct SeedGeodesicCache::Kept
 {
   GraphEdges Edges;
   SharedArray<double> Value, Step; // shared with the cut's problem
-  double Scale = 0.0, LengthWeight = 0.0;
-  // Depends on the graph alone: kept across a change of scale or length weight.
+  double LengthWeight = 0.0;
+  // Depends on the graph alone: kept across a change of length weight. Each field keeps its own
+  // scale and is rescaled to a new one (a seed sample beyond the range moves it).
   std::shared_ptr<const Adjacency> Neighbours;
   // Per seed kind (index kind - 1).
   std::vector<std::vector<std::int64_t>> Seeds;
@@ -379,14 +462,13 @@ std::vector<double> GeodesicDistances(const GeodesicGraph& graph, const std::vec
 }
 
 // With the graph copied when there is a cache, and `kinds` fields at least.
-std::shared_ptr<SeedGeodesicCache::Kept> SeedGeodesicCache::Take(const GeodesicGraph& graph, double scale, double lengthWeight,
-  int kinds, SeedGeodesicCache* cache)
+std::shared_ptr<SeedGeodesicCache::Kept> SeedGeodesicCache::Take(const GeodesicGraph& graph, double lengthWeight, int kinds,
+  SeedGeodesicCache* cache)
 {
   std::shared_ptr<SeedGeodesicCache::Kept> kept = cache ? cache->State : nullptr;
   const bool sameGraph = kept && kept->SameGraph(graph);
-  if (!sameGraph || kept->Scale != scale || kept->LengthWeight != lengthWeight)
+  if (!sameGraph || kept->LengthWeight != lengthWeight)
   {
-    // A new range (a seed sample beyond it moves it) recomputes the distances, not the adjacency.
     std::shared_ptr<const Adjacency> neighbours =
       sameGraph ? kept->Neighbours : std::make_shared<const Adjacency>(*graph.Edges, graph.Nodes(), graph.Step);
     kept = std::make_shared<SeedGeodesicCache::Kept>();
@@ -396,7 +478,6 @@ std::shared_ptr<SeedGeodesicCache::Kept> SeedGeodesicCache::Take(const GeodesicG
       kept->Edges = graph.Edges->Keepable();
       kept->Value = graph.Value;
       kept->Step = graph.Step;
-      kept->Scale = scale;
       kept->LengthWeight = lengthWeight;
     }
   }
@@ -500,7 +581,7 @@ bool UpdateKinds(const GeodesicGraph& graph, std::vector<std::vector<std::int64_
   std::vector<int> update;
   for (int k = 0; k < static_cast<int>(seeds.size()); ++k)
   {
-    if (kept.Seeds[k] != seeds[k] || kept.Field[k].Distance.empty())
+    if (kept.Seeds[k] != seeds[k] || kept.Field[k].Distance.empty() || kept.Field[k].Scale != scale)
     {
       update.push_back(k);
     }
@@ -540,7 +621,7 @@ std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph& graph, c
   const ParallelFor& parallel)
 {
   scale = UsableScale(scale);
-  std::shared_ptr<SeedGeodesicCache::Kept> kept = SeedGeodesicCache::Take(graph, scale, lengthWeight, kinds, cache);
+  std::shared_ptr<SeedGeodesicCache::Kept> kept = SeedGeodesicCache::Take(graph, lengthWeight, kinds, cache);
   std::vector<std::vector<std::int64_t>> seeds(kinds);
   for (int k = 0; k < kinds; ++k)
   {
@@ -574,7 +655,7 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
     return true;
   }
   scale = UsableScale(scale);
-  std::shared_ptr<SeedGeodesicCache::Kept> kept = SeedGeodesicCache::Take(graph, scale, par.LengthWeight, 2, cache);
+  std::shared_ptr<SeedGeodesicCache::Kept> kept = SeedGeodesicCache::Take(graph, par.LengthWeight, 2, cache);
   if (!UpdateKinds(graph, std::move(seeds), scale, par.LengthWeight, parallel, progress, *kept))
   {
     return false;

@@ -48,12 +48,13 @@ struct GeodesicGraph
 std::vector<double> GeodesicDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
   std::uint8_t seedKind, double scale, double lengthWeight, const ProgressFunction& progress = NoProgress());
 
-// What the spatial term keeps for the next cut of the same graph (values, steps, scale and length
-// weight): the adjacency, and per seed kind the seed nodes, their distances and each node's root
-// seed. A cut whose seeds of a kind are the kept ones reuses their distances; added seeds run
-// Dijkstra from themselves, bounded by the kept distances (they only shrink); nodes rooted at a
-// removed seed restart from their neighbours that kept theirs. Any other change starts afresh. Not
-// for sharing between threads.
+// What the spatial term keeps for the next cut of the same graph (values, steps and length weight):
+// the adjacency, and per seed kind the seed nodes, their distances with the scale they are in, and
+// each node's root seed and previous node. A cut whose seeds of a kind are the kept ones, at the
+// kept scale, reuses their distances. A new scale sums each node's kept path again and runs
+// Dijkstra from the nodes an edge then shortens; added seeds run Dijkstra from themselves, bounded
+// by the kept distances (they only shrink); nodes rooted at a removed seed restart from their
+// neighbours that kept theirs. Any other change starts afresh. Not for sharing between threads.
 class SeedGeodesicCache
 {
 public:
@@ -68,8 +69,7 @@ private:
   std::shared_ptr<Kept> State;
   // The kept distances when they were made on this graph, else a fresh record; the cache is empty
   // until the caller stores the record back whole.
-  static std::shared_ptr<Kept> Take(const GeodesicGraph& graph, double scale, double lengthWeight, int kinds,
-    SeedGeodesicCache* cache);
+  static std::shared_ptr<Kept> Take(const GeodesicGraph& graph, double lengthWeight, int kinds, SeedGeodesicCache* cache);
 };
 
 // The spatial term per voxel of each node (costObject, costBackground), from the distances to the
