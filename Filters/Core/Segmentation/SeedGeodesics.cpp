@@ -193,6 +193,7 @@ struct DistanceField
   std::vector<double> Distance;
   std::vector<std::int32_t> Root;   // -1 unreachable (fewer than 2^31 nodes)
   std::vector<std::int32_t> Parent; // the previous node on the path; -1 at seeds and unreachable
+  std::vector<float> ParentStep;    // the length of the edge from it (the adjacency's float)
   double Scale = 0.0;               // the intensity unit the distances are in
 };
 
@@ -211,6 +212,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
     field.Distance.assign(n, std::numeric_limits<double>::infinity());
     field.Root.assign(n, -1);
     field.Parent.assign(n, -1);
+    field.ParentStep.assign(n, 0.0f);
   }
   field.Scale = scale;
   std::vector<double>& distance = field.Distance;
@@ -261,6 +263,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
         distance[q] = candidate;
         field.Root[q] = root;
         field.Parent[q] = static_cast<std::int32_t>(p);
+        field.ParentStep[q] = static_cast<float>(step);
         heap.Push(key(candidate, q));
       }
     });
@@ -269,7 +272,8 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
 }
 
 // `field` (exact at field.Scale) made exact at `scale` for the same seeds. Each node's distance is
-// first summed again along its kept path, edge by edge as Dijkstra sums it: an upper bound, exact
+// first summed again along its kept path, edge by edge as Dijkstra sums it (each node keeps the
+// length of the edge it came by): an upper bound, exact
 // where the path stays shortest. Then every node that some edge now shortens starts Dijkstra.
 // False when progress asks to abort. Paths are acyclic (a node's previous node is set only when
 // it strictly shortens its distance); should one not be, the field is emptied, to start afresh.
@@ -302,9 +306,7 @@ bool Rescale(const GeodesicGraph& g, const Adjacency& adjacency, double scale, d
     for (auto c = path.rbegin(); c != path.rend(); ++c)
     {
       const std::int64_t from = field.Parent[*c];
-      double step = std::numeric_limits<double>::infinity();
-      adjacency.ForEach(from, [&](std::int64_t r, double s) { step = r == *c ? std::min(step, s) : step; });
-      distance[*c] = Extended(distance[from], value, from, *c, step, inverse, lengthWeight);
+      distance[*c] = Extended(distance[from], value, from, *c, field.ParentStep[*c], inverse, lengthWeight);
     }
     path.clear();
   }
@@ -325,6 +327,7 @@ bool Rescale(const GeodesicGraph& g, const Adjacency& adjacency, double scale, d
         field.Distance[q] = candidate;
         field.Root[q] = field.Root[p];
         field.Parent[q] = static_cast<std::int32_t>(p);
+        field.ParentStep[q] = static_cast<float>(step);
         if (!queued[q])
         {
           queued[q] = 1;
@@ -387,6 +390,7 @@ bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::
             field.Distance[p] = candidate;
             field.Root[p] = field.Root[q];
             field.Parent[p] = static_cast<std::int32_t>(q);
+            field.ParentStep[p] = static_cast<float>(step);
           }
         }
       });
