@@ -861,30 +861,54 @@ TEST(Task, TheGeodesicTermFindsWhatTheHistogramsCannot)
   }
 }
 
+// A noisy 40 x 30 grid (a bright disc) as explicit edges with random steps, for the kept-distance tests.
+struct NoisyGridGraph
+{
+  explicit NoisyGridGraph(unsigned seed)
+    : g(Grid2(40, 30))
+  {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<double> value(g.Size());
+    for (int j = 0; j < 30; ++j)
+      for (int i = 0; i < 40; ++i)
+        value[g.Index(i, j, 0)] = (std::hypot(i - 15, j - 15) < 9 ? 50.0 : 10.0) + 5.0 * u(rng);
+    std::vector<std::int64_t> a, b;
+    std::vector<double> step;
+    GraphEdges::Grid(40, 30, 1).ForEach([&](std::int64_t, std::int64_t p, std::int64_t q) {
+      a.push_back(p);
+      b.push_back(q);
+      step.push_back(0.5 + u(rng));
+    });
+    edges = GraphEdges::Owned(std::move(a), std::move(b));
+    graph.Edges = &edges;
+    graph.Value = value;
+    graph.Step = step;
+  }
+  NoisyGridGraph(const NoisyGridGraph&) = delete;
+  // Seed kinds per node: 1 on `object`, 2 on `background`.
+  std::vector<std::uint8_t> Hard(const std::vector<std::int64_t>& object, const std::vector<std::int64_t>& background) const
+  {
+    std::vector<std::uint8_t> hard(g.Size(), 0);
+    for (std::int64_t v : object)
+      hard[v] = 1;
+    for (std::int64_t v : background)
+      hard[v] = 2;
+    return hard;
+  }
+  ImageGeometry g;
+  GraphEdges edges;
+  GeodesicGraph graph;
+};
+
 TEST(SeedGeodesics, KeptDistancesEqualFreshOnes)
 {
   // A noisy 40 x 30 grid as explicit edges with random steps; a chain of seed edits through one
   // cache: seeds added, removed, moved, both kinds at once, nothing changed. Every cut's costs
   // equal those computed afresh (up to the rounding of equal-length paths summed in another order).
-  ImageGeometry g = Grid2(40, 30);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<double> value(g.Size());
-  for (int j = 0; j < 30; ++j)
-    for (int i = 0; i < 40; ++i)
-      value[g.Index(i, j, 0)] = (std::hypot(i - 15, j - 15) < 9 ? 50.0 : 10.0) + 5.0 * u(rng);
-  std::vector<std::int64_t> a, b;
-  std::vector<double> step;
-  GraphEdges::Grid(40, 30, 1).ForEach([&](std::int64_t, std::int64_t p, std::int64_t q) {
-    a.push_back(p);
-    b.push_back(q);
-    step.push_back(0.5 + u(rng));
-  });
-  const GraphEdges edges(a, b);
-  GeodesicGraph graph;
-  graph.Edges = &edges;
-  graph.Value = value;
-  graph.Step = step;
+  const NoisyGridGraph grid(5);
+  const ImageGeometry& g = grid.g;
+  const GeodesicGraph& graph = grid.graph;
   const std::vector<std::vector<std::int64_t>> object = { { g.Index(15, 15, 0) }, { g.Index(15, 15, 0), g.Index(12, 18, 0) },
     { g.Index(12, 18, 0) }, { g.Index(13, 18, 0) }, { g.Index(13, 18, 0), g.Index(18, 12, 0) }, { g.Index(13, 18, 0), g.Index(18, 12, 0) },
     { g.Index(16, 16, 0) } };
@@ -895,11 +919,7 @@ TEST(SeedGeodesics, KeptDistancesEqualFreshOnes)
   SeedGeodesicParameters p;
   for (std::size_t edit = 0; edit < object.size(); ++edit)
   {
-    std::vector<std::uint8_t> hard(g.Size(), 0);
-    for (std::int64_t v : object[edit])
-      hard[v] = 1;
-    for (std::int64_t v : background[edit])
-      hard[v] = 2;
+    const std::vector<std::uint8_t> hard = grid.Hard(object[edit], background[edit]);
     std::vector<double> keptObject, keptBackground, freshObject, freshBackground;
     ASSERT_TRUE(SeedGeodesicCosts(graph, hard, 40.0, p, SerialFor(), keptObject, keptBackground, NoProgress(), &cache));
     ASSERT_TRUE(SeedGeodesicCosts(graph, hard, 40.0, p, SerialFor(), freshObject, freshBackground));
@@ -923,25 +943,9 @@ TEST(SeedGeodesics, KeptDistancesAtANewScaleEqualFreshOnes)
   // The intensity unit moves from cut to cut (a seed sample beyond the histogram's range widens it),
   // with and without seed edits: the kept distances, summed again along their paths and repaired
   // where an edge now shortens them, equal those computed afresh at that scale.
-  ImageGeometry g = Grid2(40, 30);
-  std::mt19937 rng(9);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<double> value(g.Size());
-  for (int j = 0; j < 30; ++j)
-    for (int i = 0; i < 40; ++i)
-      value[g.Index(i, j, 0)] = (std::hypot(i - 15, j - 15) < 9 ? 50.0 : 10.0) + 5.0 * u(rng);
-  std::vector<std::int64_t> a, b;
-  std::vector<double> step;
-  GraphEdges::Grid(40, 30, 1).ForEach([&](std::int64_t, std::int64_t p, std::int64_t q) {
-    a.push_back(p);
-    b.push_back(q);
-    step.push_back(0.5 + u(rng));
-  });
-  const GraphEdges edges(a, b);
-  GeodesicGraph graph;
-  graph.Edges = &edges;
-  graph.Value = value;
-  graph.Step = step;
+  const NoisyGridGraph grid(9);
+  const ImageGeometry& g = grid.g;
+  const GeodesicGraph& graph = grid.graph;
   const double scales[] = { 40.0, 44.0, 44.0, 30.0, 400.0, 4.0, 40.0 };
   const std::vector<std::vector<std::int64_t>> object = { { g.Index(15, 15, 0) }, { g.Index(15, 15, 0) },
     { g.Index(12, 18, 0) }, { g.Index(12, 18, 0), g.Index(18, 12, 0) }, { g.Index(18, 12, 0) }, { g.Index(18, 12, 0) },
@@ -952,11 +956,7 @@ TEST(SeedGeodesics, KeptDistancesAtANewScaleEqualFreshOnes)
   SeedGeodesicCache cache;
   for (std::size_t edit = 0; edit < object.size(); ++edit)
   {
-    std::vector<std::uint8_t> hard(g.Size(), 0);
-    for (std::int64_t v : object[edit])
-      hard[v] = 1;
-    for (std::int64_t v : background[edit])
-      hard[v] = 2;
+    const std::vector<std::uint8_t> hard = grid.Hard(object[edit], background[edit]);
     const std::vector<std::vector<double>> kept = SeedKindDistances(graph, hard, 2, scales[edit], 0.01, NoProgress(), &cache);
     ASSERT_EQ(kept.size(), 2u);
     for (int kind : { 1, 2 })
