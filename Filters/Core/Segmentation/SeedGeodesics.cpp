@@ -192,8 +192,11 @@ struct DistanceField
 {
   std::vector<double> Distance;
   std::vector<std::int32_t> Root;   // -1 unreachable (fewer than 2^31 nodes)
-  std::vector<std::int32_t> Parent; // the previous node on the path; -1 at seeds and unreachable
-  std::vector<float> ParentStep;    // the length of the edge from it (the adjacency's float)
+  // Kept fields only (a new scale rescales them): the previous node on each path, -1 at seeds and
+  // unreachable nodes, and the length of the edge from it (the adjacency's float).
+  bool KeepsPaths = false;
+  std::vector<std::int32_t> Parent;
+  std::vector<float> ParentStep;
   double Scale = 0.0;               // the intensity unit the distances are in
 };
 
@@ -211,8 +214,11 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   {
     field.Distance.assign(n, std::numeric_limits<double>::infinity());
     field.Root.assign(n, -1);
-    field.Parent.assign(n, -1);
-    field.ParentStep.assign(n, 0.0f);
+    if (field.KeepsPaths)
+    {
+      field.Parent.assign(n, -1);
+      field.ParentStep.assign(n, 0.0f);
+    }
   }
   field.Scale = scale;
   std::vector<double>& distance = field.Distance;
@@ -233,7 +239,10 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   {
     distance[p] = 0.0;
     field.Root[p] = static_cast<std::int32_t>(p);
-    field.Parent[p] = -1;
+    if (field.KeepsPaths)
+    {
+      field.Parent[p] = -1;
+    }
     heap.Push(key(0.0, p));
   }
   for (std::int64_t p : start)
@@ -262,8 +271,11 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
       {
         distance[q] = candidate;
         field.Root[q] = root;
-        field.Parent[q] = static_cast<std::int32_t>(p);
-        field.ParentStep[q] = static_cast<float>(step);
+        if (field.KeepsPaths)
+        {
+          field.Parent[q] = static_cast<std::int32_t>(p);
+          field.ParentStep[q] = static_cast<float>(step);
+        }
         heap.Push(key(candidate, q));
       }
     });
@@ -275,12 +287,18 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
 // first summed again along its kept path, edge by edge as Dijkstra sums it (each node keeps the
 // length of the edge it came by): an upper bound, exact
 // where the path stays shortest. Then every node that some edge now shortens starts Dijkstra.
-// False when progress asks to abort. Paths are acyclic (a node's previous node is set only when
-// it strictly shortens its distance); should one not be, the field is emptied, to start afresh.
+// False when progress asks to abort. A field without paths is emptied, to start afresh; so is one
+// whose path is not acyclic, which cannot happen (a node's previous node is set only when it
+// strictly shortens its distance).
 bool Rescale(const GeodesicGraph& g, const Adjacency& adjacency, double scale, double lengthWeight,
   DistanceField& field, const ProgressFunction& progress)
 {
   const std::int64_t n = g.Nodes();
+  if (!field.KeepsPaths)
+  {
+    field = DistanceField();
+    return true;
+  }
   const double* value = g.Value.data();
   const double inverse = 1.0 / scale;
   std::vector<double> distance(n, std::numeric_limits<double>::quiet_NaN());
@@ -296,6 +314,7 @@ bool Rescale(const GeodesicGraph& g, const Adjacency& adjacency, double scale, d
       if (static_cast<std::int64_t>(path.size()) > n)
       {
         field = DistanceField();
+        field.KeepsPaths = true;
         return true;
       }
     }
@@ -373,7 +392,10 @@ bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::
       {
         field.Distance[p] = std::numeric_limits<double>::infinity();
         field.Root[p] = -1;
-        field.Parent[p] = -1;
+        if (field.KeepsPaths)
+        {
+          field.Parent[p] = -1;
+        }
         orphans.push_back(p);
       }
     }
@@ -389,8 +411,11 @@ bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::
           {
             field.Distance[p] = candidate;
             field.Root[p] = field.Root[q];
-            field.Parent[p] = static_cast<std::int32_t>(q);
-            field.ParentStep[p] = static_cast<float>(step);
+            if (field.KeepsPaths)
+            {
+              field.Parent[p] = static_cast<std::int32_t>(q);
+              field.ParentStep[p] = static_cast<float>(step);
+            }
           }
         }
       });
@@ -489,6 +514,10 @@ std::shared_ptr<SeedGeodesicCache::Kept> SeedGeodesicCache::Take(const GeodesicG
   {
     kept->Field.resize(kinds);
     kept->Seeds.resize(kinds);
+  }
+  for (DistanceField& field : kept->Field)
+  {
+    field.KeepsPaths = field.KeepsPaths || cache != nullptr;
   }
   if (cache)
   {
