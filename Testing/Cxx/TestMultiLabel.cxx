@@ -364,7 +364,7 @@ TEST(MultiLabel, TheSecondChannelTellsTheLabelsApart)
 
 TEST(MultiLabel, LargeGraphsRunTheirKindsFromAHelperThread)
 {
-  // A grid over 2^20 nodes (the voxel cut's graphs): three kinds run from a helper thread on two
+  // A grid of 1.08 M nodes (a voxel cut's graph): three kinds run from a helper thread on two
   // threads give each kind's own distances; progress comes on this thread and rises; an abort
   // comes back at once as empty distances.
   const int nx = 128, ny = 128, nz = 66;

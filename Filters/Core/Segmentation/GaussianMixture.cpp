@@ -25,6 +25,11 @@ struct Component
   Matrix Covariance;
 };
 
+double TotalWeight(const std::vector<Component>& components)
+{
+  return std::accumulate(components.begin(), components.end(), 0.0, [](double s, const Component& c) { return s + c.Weight; });
+}
+
 // The weighted mean and covariance (+ regularisation) of the points i with `use(i)`.
 template <typename Use>
 Component Moments(const std::vector<Vector>& x, const std::vector<double>& w, const Vector& reg, Use use)
@@ -112,8 +117,7 @@ double Expectation(const std::vector<Vector>& x, const std::vector<double>& w, c
   std::vector<double> resp;
   for (int it = 0; it < MaxIterations; ++it)
   {
-    const double total = std::accumulate(components.begin(), components.end(), 0.0,
-      [](double s, const Component& c) { return s + c.Weight; });
+    const double total = TotalWeight(components);
     std::vector<Prepared> prepared;
     for (const Component& c : components)
     {
@@ -254,8 +258,7 @@ GaussianMixture FitGaussianMixture(const std::vector<double>& points, const std:
       best.Weight.clear();
       best.Mean.clear();
       best.Covariance.clear();
-      const double sum = std::accumulate(components.begin(), components.end(), 0.0,
-        [](double s, const Component& c) { return s + c.Weight; });
+      const double sum = TotalWeight(components);
       for (const Component& c : components)
       {
         best.Weight.push_back(c.Weight / sum);

@@ -24,10 +24,6 @@ namespace
 {
 // Pops between progress checks.
 constexpr std::int64_t CheckEvery = (std::int64_t(1) << 16) - 1;
-// Graphs up to this many nodes run their seed kinds at once without a progress report (a whole run
-// over BraTS's 266 k elements takes ~0.05 s here); larger ones (voxel grids) run from a helper
-// thread while the caller's reports progress.
-constexpr std::int64_t ConcurrentNodes = std::int64_t(1) << 20;
 
 // Neighbours of a node with the step to each, each entry a 32-bit neighbour id with its step as a
 // float beside it (the cuts allow fewer than 2^31 nodes and edge ends): for explicit edges with at
@@ -605,9 +601,8 @@ bool RunReportingHere(std::int64_t count, const ParallelFor& parallel, const Pro
 }
 
 // The kept distances of kinds 1..seeds.size() made exact for these seed nodes: kinds whose seeds
-// changed are updated side by side on `parallel`'s threads, over [0, 0.9] of progress. Up to
-// ConcurrentNodes nodes progress is reported after them only; beyond, they run from a helper
-// thread while this one reports progress (RunReportingHere). False when progress asks to abort.
+// changed are updated side by side on `parallel`'s threads from a helper thread while this one
+// reports progress over [0, 0.9] (RunReportingHere). False when progress asks to abort.
 bool UpdateKinds(const GeodesicGraph& graph, std::vector<std::vector<std::int64_t>> seeds, double scale,
   double lengthWeight, const ParallelFor& parallel, const ProgressFunction& progress, SeedGeodesicCache::Kept& kept)
 {
@@ -624,20 +619,7 @@ bool UpdateKinds(const GeodesicGraph& graph, std::vector<std::vector<std::int64_
     return UpdateField(graph, *kept.Neighbours, kept.Seeds[k], seeds[k], scale, lengthWeight, kept.Field[k], report);
   };
   const std::int64_t count = static_cast<std::int64_t>(update.size());
-  if (graph.Nodes() <= ConcurrentNodes)
-  {
-    parallel(count, 1, [&](std::int64_t i0, std::int64_t i1) {
-      for (std::int64_t i = i0; i < i1; ++i)
-      {
-        run(i, NoProgress());
-      }
-    });
-    if (!progress(0.9))
-    {
-      return false;
-    }
-  }
-  else if (count > 0 && !RunReportingHere(count, parallel, progress, run))
+  if (count == 0 ? !progress(0.9) : !RunReportingHere(count, parallel, progress, run))
   {
     return false;
   }
