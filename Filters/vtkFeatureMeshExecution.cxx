@@ -4,22 +4,206 @@
 
 #include "vtkAbstractArray.h"
 #include "vtkAlgorithm.h"
+#include "vtkAOSDataArrayTemplate.h"
+#include "vtkCellData.h"
+#include "vtkDataArray.h"
 #include "vtkDataObject.h"
 #include "vtkDataSet.h"
 #include "vtkDemandDrivenPipeline.h"
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
+#include "vtkInformationDoubleVectorKey.h"
+#include "vtkInformationInformationVectorKey.h"
 #include "vtkInformationVector.h"
 #include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPointSet.h"
 #include "vtkSMPTools.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkType.h"
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
 namespace featuremesh
 {
+namespace
+{
+// Lowest and highest of `n` values `stride` apart; false when one is NaN.
+template <typename T, typename Stride>
+bool MinMax(const T* values, vtkIdType n, Stride stride, T& low, T& high)
+{
+  low = high = values[0];
+  bool nan = false;
+  for (vtkIdType t = 0; t < n; ++t)
+  {
+    const T v = values[t * stride];
+    if constexpr (std::is_floating_point<T>::value)
+    {
+      nan |= v != v;
+    }
+    low = v < low ? v : low;
+    high = v > high ? v : high;
+  }
+  return !nan;
+}
+
+// Per component: lowest and highest value (`range`), and of the finite values (`finite`); false
+// when a value is NaN or no value of a component is finite.
+template <typename T>
+bool ComponentRanges(const T* values, vtkIdType tuples, int components, std::vector<double>& range, std::vector<double>& finite)
+{
+  range.assign(2 * components, 0.0);
+  finite.assign(2 * components, 0.0);
+  for (int c = 0; c < components; ++c)
+  {
+    T low, high;
+    // One component is a contiguous loop, which the compiler vectorises (0.7 ms for BraTS's voxels).
+    if (!(components == 1 ? MinMax(values, tuples, std::integral_constant<int, 1>(), low, high)
+                          : MinMax(values + c, tuples, components, low, high)))
+    {
+      return false;
+    }
+    double finiteLow = static_cast<double>(low), finiteHigh = static_cast<double>(high);
+    if (!(std::isfinite(finiteLow) && std::isfinite(finiteHigh)))
+    {
+      finiteLow = std::numeric_limits<double>::infinity();
+      finiteHigh = -finiteLow;
+      for (vtkIdType t = 0; t < tuples; ++t)
+      {
+        const double v = static_cast<double>(values[t * components + c]);
+        if (std::isfinite(v))
+        {
+          finiteLow = std::min(finiteLow, v);
+          finiteHigh = std::max(finiteHigh, v);
+        }
+      }
+      if (finiteLow > finiteHigh)
+      {
+        return false;
+      }
+    }
+    range[2 * c] = static_cast<double>(low);
+    range[2 * c + 1] = static_cast<double>(high);
+    finite[2 * c] = finiteLow;
+    finite[2 * c + 1] = finiteHigh;
+  }
+  return true;
+}
+
+bool ComponentRanges(vtkDataArray* array, std::vector<double>& range, std::vector<double>& finite)
+{
+  const vtkIdType tuples = array->GetNumberOfTuples();
+  const int components = array->GetNumberOfComponents();
+  switch (array->GetDataType())
+  {
+#define FEATUREMESH_RANGE_CASE(code, type)                                                                  \
+  case code:                                                                                              \
+  {                                                                                                       \
+    auto* typed = vtkAOSDataArrayTemplate<type>::FastDownCast(array);                                     \
+    return typed && ComponentRanges(typed->GetPointer(0), tuples, components, range, finite);             \
+  }
+    FEATUREMESH_RANGE_CASE(VTK_FLOAT, float)
+    FEATUREMESH_RANGE_CASE(VTK_DOUBLE, double)
+    FEATUREMESH_RANGE_CASE(VTK_CHAR, char)
+    FEATUREMESH_RANGE_CASE(VTK_SIGNED_CHAR, signed char)
+    FEATUREMESH_RANGE_CASE(VTK_UNSIGNED_CHAR, unsigned char)
+    FEATUREMESH_RANGE_CASE(VTK_SHORT, short)
+    FEATUREMESH_RANGE_CASE(VTK_UNSIGNED_SHORT, unsigned short)
+    FEATUREMESH_RANGE_CASE(VTK_INT, int)
+    FEATUREMESH_RANGE_CASE(VTK_UNSIGNED_INT, unsigned int)
+    FEATUREMESH_RANGE_CASE(VTK_LONG, long)
+    FEATUREMESH_RANGE_CASE(VTK_UNSIGNED_LONG, unsigned long)
+    FEATUREMESH_RANGE_CASE(VTK_LONG_LONG, long long)
+    FEATUREMESH_RANGE_CASE(VTK_UNSIGNED_LONG_LONG, unsigned long long)
+    FEATUREMESH_RANGE_CASE(VTK_ID_TYPE, vtkIdType)
+#undef FEATUREMESH_RANGE_CASE
+    default:
+      return false;
+  }
+}
+
+// True when `key` holds a range for every component that is newer than the array's values.
+bool HasCurrentRanges(vtkDataArray* array, vtkInformationInformationVectorKey* key)
+{
+  vtkInformationVector* perComponent = array->GetInformation()->Get(key);
+  if (!perComponent || perComponent->GetNumberOfInformationObjects() < array->GetNumberOfComponents())
+  {
+    return false;
+  }
+  for (int c = 0; c < array->GetNumberOfComponents(); ++c)
+  {
+    vtkInformation* info = perComponent->GetInformationObject(c);
+    if (!info->Has(vtkDataArray::COMPONENT_RANGE()) || array->GetMTime() > info->GetMTime())
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool StoreValueRange(vtkDataArray* array)
+{
+  if (!array || array->GetNumberOfTuples() == 0 ||
+    (HasCurrentRanges(array, vtkAbstractArray::PER_COMPONENT()) &&
+      HasCurrentRanges(array, vtkAbstractArray::PER_FINITE_COMPONENT())))
+  {
+    return false;
+  }
+  std::vector<double> range, finite;
+  if (!ComponentRanges(array, range, finite))
+  {
+    return false;
+  }
+  for (const auto& kind : { std::make_pair(vtkAbstractArray::PER_COMPONENT(), &range),
+         std::make_pair(vtkAbstractArray::PER_FINITE_COMPONENT(), &finite) })
+  {
+    vtkNew<vtkInformationVector> perComponent;
+    perComponent->SetNumberOfInformationObjects(array->GetNumberOfComponents());
+    for (int c = 0; c < array->GetNumberOfComponents(); ++c)
+    {
+      perComponent->GetInformationObject(c)->Set(vtkDataArray::COMPONENT_RANGE(), kind.second->data() + 2 * c, 2);
+    }
+    array->GetInformation()->Set(kind.first, perComponent);
+  }
+  return true;
+}
+} // namespace
+
+int StoreValueRanges(vtkInformationVector* outputVector)
+{
+  int stored = 0;
+  for (int port = 0; port < outputVector->GetNumberOfInformationObjects(); ++port)
+  {
+    vtkDataSet* data = vtkDataSet::SafeDownCast(outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT()));
+    if (!data)
+    {
+      continue;
+    }
+    for (vtkDataSetAttributes* attributes : { static_cast<vtkDataSetAttributes*>(data->GetPointData()),
+           static_cast<vtkDataSetAttributes*>(data->GetCellData()) })
+    {
+      for (int i = 0; i < attributes->GetNumberOfArrays(); ++i)
+      {
+        stored += StoreValueRange(attributes->GetArray(i));
+      }
+    }
+    vtkPointSet* points = vtkPointSet::SafeDownCast(data);
+    if (points && points->GetPoints())
+    {
+      stored += StoreValueRange(points->GetPoints()->GetData());
+    }
+  }
+  return stored;
+}
+
 ParallelFor SMPParallelFor()
 {
   return [](std::int64_t n, std::int64_t grain, const RangeFunction& f) {

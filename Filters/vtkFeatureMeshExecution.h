@@ -78,6 +78,13 @@ RunState PipelineState(vtkAlgorithm* algorithm, vtkInformationVector* outputVect
 // Puts the field array ContractVersion (Contract.h) first in the field data of every output.
 void PutContractVersionFirst(vtkInformationVector* outputVector);
 
+// Stores the exact value range of each component of every point and cell array (and of the points)
+// of every output in the array's information (vtkDataArray::COMPONENT_RANGE, the cache GetRange and
+// GetFiniteRange read; Modified() drops it). ParaView asks for both ranges of every array after each
+// Apply, and VTK 9.2 computes each at ~20 ns per value: 0.4 s for a BraTS label image, 8 times a
+// re-cut. Arrays holding NaN are left to VTK. Returns the arrays stored.
+int StoreValueRanges(vtkInformationVector* outputVector);
+
 // Runs a filter's body (returning int): on the STDThread SMP backend when VTK runs its Sequential
 // default and the user chose none with VTK_SMP_BACKEND_IN_USE (the host's backend is left as it
 // was), and with every exception caught at the VTK boundary. A failure is not run (and reported)
@@ -111,6 +118,7 @@ int RunFilter(vtkAlgorithm* algorithm, const char* filter, vtkInformationVector*
   if (result)
   {
     PutContractVersionFirst(outputVector);
+    StoreValueRanges(outputVector);
   }
   failedAt = result ? 0 : state.Modified;
   failedAtTime = state.TimeStep;

@@ -14,7 +14,9 @@ Speed table: each stage's seconds and the pipeline's (median of --runs fresh run
 cut's (once when it takes over 5 s) and their ratio; in 3D the classic pipeline a user would otherwise
 run, the voxel cut then CGAL Mesh_3 on its labels (FeatureMeshClassicMesh3, built with the tests;
 facet distance 2, object and background meshed), and its ratio; the re-cut after a seed edit (recut_s:
-the first object seed moved by one voxel, only the cut re-run) and the voxel cut's ratio to it.
+the first object seed moved by one voxel, only the cut re-run) and the voxel cut's ratio to it. After
+each Apply the GUI also waits for ParaView's data information of every output port (array ranges,
+bounds, sizes): info_s for the four stages' outputs, recut_info_s for the re-cut's.
 
 Segmentation table: Dice of the pipeline, the voxel cut, scikit-image's random walker (image mapped to [0, 1] by its
 0.5/99.5 percentiles, so that one beta means the same on every image: 2e5, featuremesh.metrics; over 2 M voxels on 2 x 2 x 2
@@ -73,6 +75,15 @@ def timed(proxy):
     return time.perf_counter() - t
 
 
+def information_seconds(proxy):
+    """Seconds ParaView takes to gather the data information of every output port, as the GUI
+    does after an Apply (the Information panel, the representations' colour ranges)."""
+    t = time.perf_counter()
+    for port in range(proxy.GetNumberOfOutputPorts()):
+        proxy.GetDataInformation(port).GetNumberOfPoints()
+    return time.perf_counter() - t
+
+
 def classic_mesh3(labels, image):
     """Seconds of CGAL Mesh_3 on a voxel cut's labels (FeatureMeshClassicMesh3, built with the tests;
     object and background both meshed, facet distance 2), or None when the program is absent."""
@@ -95,6 +106,7 @@ def run_case(case, args):
     truth = T.reshape(shape).astype(bool)
     # Fresh proxies every run: re-executing a proxy would only measure ParaView's cache.
     times = {"nodes": [], "mesh": [], "smoothing": [], "cut": []}
+    info = []
     for _ in range(args.runs):
         nodes = case.feature_nodes()
         delaunay = case.mesh(nodes)
@@ -104,6 +116,7 @@ def run_case(case, args):
         case.background_seeds.UpdatePipeline()
         for key, proxy in (("nodes", nodes), ("mesh", delaunay), ("smoothing", mesh), ("cut", cut)):
             times[key].append(timed(proxy))
+        info.append(sum(information_seconds(proxy) for proxy in (nodes, delaunay, mesh, cut)))
     labelled = fm.fetch(cut, 0)
     L = fm.labels(cut)
     # Re-cut after a seed edit: the same mesh, the first object seed moved by one voxel and back;
@@ -114,11 +127,12 @@ def run_case(case, args):
     recut = ps.SuperVoxelCut(Mesh=mesh, ObjectSeeds=edited, BackgroundSeeds=case.background_seeds, Image=case.image,
                              Scalars=case.scalars)
     recut.UpdatePipeline()
-    rt = []
+    rt, rti = [], []
     for k in range(max(3, args.runs)):
         points[0] += spacing[0] * (1 if k % 2 == 0 else -1)
         edited.Points = points
         rt.append(timed(recut))
+        rti.append(information_seconds(recut))
     ps.Delete(recut)
     vt = []
     for _ in range(args.runs):
@@ -139,6 +153,7 @@ def run_case(case, args):
            "nodes_s": med["nodes"], "mesh_s": med["mesh"], "smoothing_s": med["smoothing"], "cut_s": med["cut"], "total_s": total,
            "voxel_cut_s": statistics.median(vt), "speedup": statistics.median(vt) / total,
            "recut_s": statistics.median(rt), "recut_speedup": statistics.median(vt) / statistics.median(rt),
+           "info_s": statistics.median(info), "recut_info_s": statistics.median(rti),
            "dice_supervoxel": fm.dice(L, T), "dice_voxel": fm.dice(V, T),
            "components": int(field(labelled, "ObjectComponents")[0]),
            "added_nodes_pct": 100.0 * float(field(labelled, "AddedNodes")[0]) / raw.GetNumberOfPoints(),
@@ -233,12 +248,12 @@ def main():
     seg = [k for k in keys if k in ("case", "components") or k.startswith("dice_") or k.endswith(("walker_s", "shed_s", "_scale"))]
     speed = [k for k in keys if k in ("case", "voxels", "elements", "nodes_s", "mesh_s", "smoothing_s", "cut_s", "total_s",
                                       "voxel_cut_s", "speedup", "mesh3_s", "classic_s", "classic_speedup", "recut_s",
-                                      "recut_speedup")]
+                                      "recut_speedup", "info_s", "recut_info_s")]
     mq = [k for k in keys if k in ("case", "mesh_s", "smoothing_s", "added_nodes_pct") or k.startswith(("min_angle", "max_angle"))]
     sp = [k for k in keys if k == "case" or k == "K" or k.startswith(("oracle_", "asa_", "boundary_", "slic_"))]
     lines = ["Machine: %s; medians of %d runs (voxel cut: once when over 5 s)." % (machine, args.runs), "",
              "## Speed (seconds; speedup = voxel cut / pipeline, classic = voxel cut + CGAL Mesh_3 of its labels, "
-             "recut = the cut after a seed edit)", ""] + markdown(rows, speed)
+             "recut = the cut after a seed edit; info = ParaView's data information of the outputs after Apply)", ""] + markdown(rows, speed)
     lines += ["", "## Segmentation (Dice at the defaults)", ""] + markdown(rows, seg)
     lines += ["", "## Mesh quality: Delaunay Image Mesh, then Image Mesh Smoothing (angles in degrees; 3D dihedral)", ""]
     lines += markdown(rows, mq)

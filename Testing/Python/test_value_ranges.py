@@ -1,0 +1,79 @@
+"""Every filter stores the value range of each output array where ParaView reads it (the array's
+range cache): after each Apply ParaView asks every array for its range and its finite range, which
+VTK 9.2 computes at ~20 ns per value. The cached ranges must be present and equal what VTK computes
+from the values; a change of the values (Modified) must drop them. Bundled cases: the liver (3D,
+every filter) and nuclei (2D)."""
+import fmtest as ft
+from vtkmodules.vtkCommonCore import vtkAbstractArray, vtkDataArray
+
+
+def cached(array, key):
+    """The per-component ranges stored under `key`, or None when any is missing or stale."""
+    per = array.GetInformation().Get(key)
+    if per is None or per.GetNumberOfInformationObjects() < array.GetNumberOfComponents():
+        return None
+    out = []
+    for c in range(array.GetNumberOfComponents()):
+        info = per.GetInformationObject(c)
+        if not info.Has(vtkDataArray.COMPONENT_RANGE()) or array.GetMTime() > info.GetMTime():
+            return None
+        out.append(tuple(info.Get(vtkDataArray.COMPONENT_RANGE())))
+    return out
+
+
+def computed(array):
+    """(ranges, finite ranges) per component, computed by VTK from a fresh copy of the values."""
+    copy = array.NewInstance()
+    copy.DeepCopy(array)
+    n = copy.GetNumberOfComponents()
+    return [tuple(copy.GetRange(c)) for c in range(n)], [tuple(copy.GetFiniteRange(c)) for c in range(n)]
+
+
+def arrays_of(data):
+    for attrs, where in ((data.GetPointData(), "point"), (data.GetCellData(), "cell")):
+        for i in range(attrs.GetNumberOfArrays()):
+            a = attrs.GetArray(i)
+            if a is not None and a.GetNumberOfTuples() > 0:
+                yield "%s array %s" % (where, a.GetName()), a
+    if hasattr(data, "GetPoints") and data.GetPoints() is not None and data.GetNumberOfPoints() > 0:
+        yield "points", data.GetPoints().GetData()
+
+
+def check_outputs(label, proxy):
+    proxy.UpdatePipeline()
+    algorithm = proxy.GetClientSideObject()
+    checked = 0
+    for port in range(proxy.GetNumberOfOutputPorts()):
+        data = algorithm.GetOutputDataObject(port)
+        for what, a in arrays_of(data):
+            ranges, finite = computed(a)
+            has, has_finite = cached(a, vtkAbstractArray.PER_COMPONENT()), cached(a, vtkAbstractArray.PER_FINITE_COMPONENT())
+            ok = has == ranges and has_finite == finite
+            if not ok:
+                ft.check(False, "%s port %d %s: cached %s / %s, computed %s / %s" % (label, port, what, has, has_finite, ranges, finite))
+            checked += 1
+    ft.check(checked > 0, "%s: every output array's cached range equals VTK's (%d arrays)" % (label, checked))
+    return checked
+
+
+liver = ft.fm.Case(ft.case_dir("liver-ct-totalseg"))
+nodes = liver.feature_nodes()
+delaunay = liver.mesh(nodes)
+smoothed = liver.smoothing(delaunay)
+cut = liver.super_voxel_cut(smoothed)
+for label, proxy in (("Feature Nodes", nodes), ("Delaunay Image Mesh", delaunay), ("Image Mesh Smoothing", smoothed),
+                     ("Super-Voxel Cut", cut), ("Voxel Cut", liver.voxel_cut()), ("RSP Edge Enhancement", liver.rsp()),
+                     ("Segmentation Surface Smoothing", liver.surface_smoothing(cut))):
+    check_outputs("liver, " + label, proxy)
+
+nuclei = ft.fm.Case(ft.case_dir("nuclei-dsb2018"))
+check_outputs("nuclei, Super-Voxel Cut", nuclei.super_voxel_cut(nuclei.smoothing(nuclei.mesh(nuclei.feature_nodes()))))
+
+# The label image's range follows a re-cut, and a change of its values drops the cache.
+labels = cut.GetClientSideObject().GetOutputDataObject(2).GetPointData().GetArray(ft.names.Label)
+ft.check(cached(labels, vtkAbstractArray.PER_COMPONENT()) == [(0.0, 1.0)], "liver: the label image's cached range is 0..1")
+labels.SetValue(0, 7)
+labels.Modified()
+ft.check(cached(labels, vtkAbstractArray.PER_COMPONENT()) is None and labels.GetRange(0) == (0.0, 7.0),
+         "a changed label image drops its cached range, and VTK computes the new one")
+ft.finish("value range")
