@@ -297,13 +297,18 @@ bool Rescale(const GeodesicGraph& g, const Adjacency& adjacency, double scale, d
   }
   const double* value = g.Value.data();
   const double inverse = 1.0 / scale;
-  std::vector<double> distance(n, std::numeric_limits<double>::quiet_NaN());
+  // In place: a node's old distance is read only at the root of its path (a seed, 0, or an
+  // unreachable node, infinity), before it is written; `done` marks the new ones.
+  std::vector<double>& distance = field.Distance;
+  std::vector<std::uint64_t> done((n + 63) / 64, 0);
+  auto isDone = [&](std::int64_t q) { return (done[q >> 6] >> (q & 63)) & 1u; };
+  auto markDone = [&](std::int64_t q) { done[q >> 6] |= std::uint64_t(1) << (q & 63); };
   std::vector<std::int64_t> path;
   for (std::int64_t p = 0; p < n; ++p)
   {
     // Up the kept path to a node already done, or to its seed; then down, summing.
     std::int64_t q = p;
-    while (std::isnan(distance[q]) && field.Parent[q] >= 0)
+    while (!isDone(q) && field.Parent[q] >= 0)
     {
       path.push_back(q);
       q = field.Parent[q];
@@ -314,38 +319,40 @@ bool Rescale(const GeodesicGraph& g, const Adjacency& adjacency, double scale, d
         return true;
       }
     }
-    if (std::isnan(distance[q]))
+    if (!isDone(q))
     {
-      distance[q] = std::isfinite(field.Distance[q]) ? 0.0 : std::numeric_limits<double>::infinity();
+      distance[q] = std::isfinite(distance[q]) ? 0.0 : std::numeric_limits<double>::infinity();
+      markDone(q);
     }
     for (auto c = path.rbegin(); c != path.rend(); ++c)
     {
       const std::int64_t from = field.Parent[*c];
       distance[*c] = Extended(distance[from], value, from, *c, field.ParentStep[*c], inverse, lengthWeight);
+      markDone(*c);
     }
     path.clear();
   }
-  field.Distance.swap(distance);
+  // Then every node some edge now shortens starts Dijkstra (`done` now marks the queued ones).
   std::vector<std::int64_t> start;
-  std::vector<std::uint8_t> queued(n, 0);
+  std::fill(done.begin(), done.end(), 0);
   for (std::int64_t p = 0; p < n; ++p)
   {
-    const double d = field.Distance[p];
+    const double d = distance[p];
     if (!std::isfinite(d))
     {
       continue;
     }
     adjacency.ForEach(p, [&](std::int64_t q, double step) {
       const double candidate = Extended(d, value, p, q, step, inverse, lengthWeight);
-      if (candidate < field.Distance[q])
+      if (candidate < distance[q])
       {
-        field.Distance[q] = candidate;
+        distance[q] = candidate;
         field.Root[q] = field.Root[p];
         field.Parent[q] = static_cast<std::int32_t>(p);
         field.ParentStep[q] = static_cast<float>(step);
-        if (!queued[q])
+        if (!isDone(q))
         {
-          queued[q] = 1;
+          markDone(q);
           start.push_back(q);
         }
       }
