@@ -394,6 +394,9 @@ vtkUnsignedCharArray* vtkSuperVoxelCut::LabelVoxels(const std::vector<std::uint8
   {
     VoxelLabels(data.Cut.Owner, labels, image.Voxels->GetPointer(0), SMPParallelFor());
   }
+  // Written through its pointer: without Modified a kept image's cached value range (VTK's, which
+  // ParaView shows) would stay the cut's before last.
+  image.Voxels->Modified();
   image.Labels = labels;
   data.LastLabelImage = slot;
   return image.Voxels;

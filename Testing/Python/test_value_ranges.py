@@ -1,9 +1,14 @@
 """Every filter stores the value range of each output array where ParaView reads it (the array's
 range cache): after each Apply ParaView asks every array for its range and its finite range, which
 VTK 9.2 computes at ~20 ns per value. The cached ranges must be present and equal what VTK computes
-from the values; a change of the values (Modified) must drop them. Bundled cases: the liver (3D,
-every filter) and nuclei (2D)."""
+from the values; a change of the values (Modified) must drop them, also where a re-cut rewrites a
+kept label image in place. Bundled cases: the liver (3D, every filter), nuclei (2D) and the
+abdomen's labelled seeds."""
+import os
+import tempfile
+
 import fmtest as ft
+import paraview.simple as ps
 from vtkmodules.vtkCommonCore import vtkAbstractArray, vtkDataArray
 
 
@@ -76,4 +81,27 @@ labels.SetValue(0, 7)
 labels.Modified()
 ft.check(cached(labels, vtkAbstractArray.PER_COMPONENT()) is None and labels.GetRange(0) == (0.0, 7.0),
          "a changed label image drops its cached range, and VTK computes the new one")
+
+# A re-cut rewrites the label image of the cut before last in place (the one no one holds): its range
+# must follow. Labels 1..k kept, k = 5, 3, 4, 2: the third cut rewrites the first one's image.
+abdomen = os.path.join(ft.DATA, "multilabel", "abdomen-ct-totalseg")
+if os.path.isdir(abdomen):
+    image = ps.OpenDataFile(os.path.join(abdomen, "image.mha"))
+    mesh = ps.ImageMeshSmoothing(Mesh=ps.DelaunayImageMesh(Nodes=ps.FeatureNodes(Input=image), Image=image), Image=image)
+    rows = ft.np.loadtxt(os.path.join(abdomen, "seeds.csv"), delimiter=",", skiprows=1, ndmin=2)
+    folder = tempfile.mkdtemp()
+    multi = None
+    for k in (5, 3, 4, 2):
+        path = os.path.join(folder, "seeds_%d.csv" % k)
+        ft.np.savetxt(path, rows[rows[:, 3] <= k], delimiter=",", header="x,y,z,label", comments="", fmt="%g")
+        reader = ps.CSVReader(FileName=[path])
+        if multi is None:
+            multi = ps.SuperVoxelCut(Mesh=mesh, Seeds=reader, Image=image)
+        else:
+            multi.Seeds = reader
+        multi.UpdatePipeline()
+        voxels = multi.GetClientSideObject().GetOutputDataObject(2).GetPointData().GetArray(ft.names.Label)
+        shown = multi.GetDataInformation(2).GetPointDataInformation().GetArrayInformation(ft.names.Label).GetComponentRange(0)
+        ft.check(tuple(shown) == (0.0, float(k)) and computed(voxels)[0] == [(0.0, float(k))],
+                 "abdomen, labels 0..%d: ParaView shows the label image's range %s" % (k, tuple(shown)))
 ft.finish("value range")
