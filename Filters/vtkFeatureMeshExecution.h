@@ -81,8 +81,8 @@ void PutContractVersionFirst(vtkInformationVector* outputVector);
 // Stores the exact value range of each component of every point and cell array (and of the points)
 // of every output in the array's information (vtkDataArray::COMPONENT_RANGE, the cache GetRange and
 // GetFiniteRange read; Modified() drops it). ParaView asks for both ranges of every array after each
-// Apply, and VTK 9.2 computes each at ~20 ns per value: 0.4 s for a BraTS label image, 8 times a
-// re-cut. Arrays holding NaN are left to VTK. Returns the arrays stored.
+// Apply, and VTK 9.2 computes each at ~20 ns per value: 0.4 s for a BraTS label image, several times
+// what the re-cut took. Arrays holding NaN are left to VTK. Returns the arrays stored.
 int StoreValueRanges(vtkInformationVector* outputVector);
 
 // Runs a filter's body (returning int): on the STDThread SMP backend when VTK runs its Sequential
