@@ -19,6 +19,7 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPointSet.h"
+#include "vtkSetGet.h"
 #include "vtkSMPTools.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkType.h"
@@ -104,30 +105,10 @@ bool ComponentRanges(vtkDataArray* array, std::vector<double>& range, std::vecto
   const int components = array->GetNumberOfComponents();
   switch (array->GetDataType())
   {
-#define FEATUREMESH_RANGE_CASE(code, type)                                                                  \
-  case code:                                                                                              \
-  {                                                                                                       \
-    auto* typed = vtkAOSDataArrayTemplate<type>::FastDownCast(array);                                     \
-    return typed && ComponentRanges(typed->GetPointer(0), tuples, components, range, finite);             \
+    vtkTemplateMacro(auto* typed = vtkAOSDataArrayTemplate<VTK_TT>::FastDownCast(array);
+                     return typed && ComponentRanges(typed->GetPointer(0), tuples, components, range, finite));
   }
-    FEATUREMESH_RANGE_CASE(VTK_FLOAT, float)
-    FEATUREMESH_RANGE_CASE(VTK_DOUBLE, double)
-    FEATUREMESH_RANGE_CASE(VTK_CHAR, char)
-    FEATUREMESH_RANGE_CASE(VTK_SIGNED_CHAR, signed char)
-    FEATUREMESH_RANGE_CASE(VTK_UNSIGNED_CHAR, unsigned char)
-    FEATUREMESH_RANGE_CASE(VTK_SHORT, short)
-    FEATUREMESH_RANGE_CASE(VTK_UNSIGNED_SHORT, unsigned short)
-    FEATUREMESH_RANGE_CASE(VTK_INT, int)
-    FEATUREMESH_RANGE_CASE(VTK_UNSIGNED_INT, unsigned int)
-    FEATUREMESH_RANGE_CASE(VTK_LONG, long)
-    FEATUREMESH_RANGE_CASE(VTK_UNSIGNED_LONG, unsigned long)
-    FEATUREMESH_RANGE_CASE(VTK_LONG_LONG, long long)
-    FEATUREMESH_RANGE_CASE(VTK_UNSIGNED_LONG_LONG, unsigned long long)
-    FEATUREMESH_RANGE_CASE(VTK_ID_TYPE, vtkIdType)
-#undef FEATUREMESH_RANGE_CASE
-    default:
-      return false;
-  }
+  return false;
 }
 
 // True when `key` holds a range for every component that is newer than the array's values.
