@@ -161,6 +161,34 @@ TEST(BoykovJolly, VoxelRegionTermSumsVoxelCosts)
   EXPECT_EQ(exact.Label[2], 1);
 }
 
+TEST(BoykovJolly, SeedSamplesBeyondTheRobustRangeAddBinsOfItsWidth)
+{
+  // 100 nodes of values 0..99: 64 bins of ~1.53 over the robust range. Object samples beyond it add
+  // bins of that width (a seed edit moves how far the histogram reaches, not its bins' edges), up to
+  // 64 more on each side; a sample beyond those counts in the end bin.
+  std::vector<double> values;
+  for (int i = 0; i < 100; ++i)
+  {
+    values.push_back(i);
+  }
+  CutProblem pr = SeededChain(values);
+  pr.BackgroundSamples = { 0.0, 1.0, 2.0, 3.0 };
+  BoykovJollyParameters par;
+  par.Bins = 64;
+  auto bins = [&](double farthest) {
+    pr.ObjectSamples = { 96.0, 97.0, 98.0, farthest };
+    const CutResult r = BoykovJollyCut(pr, par);
+    EXPECT_TRUE(r.Error.empty()) << r.Error;
+    return r.Bins;
+  };
+  const double width = 98.0 / 64;
+  EXPECT_EQ(bins(99.0), 64);
+  EXPECT_NEAR(bins(150.0) - bins(120.0), 30.0 / width, 1.0);
+  EXPECT_EQ(bins(1e6), 128);
+  pr.BackgroundSamples = { -1e6, 1.0, 2.0, 3.0 };
+  EXPECT_EQ(bins(1e6), 192);
+}
+
 TEST(BoykovJolly, AnOutlierFarBeyondTheRangeCountsInTheLastBin)
 {
   // 40 nodes of 5 voxels in [0, 20]; the largest voxel is 25, 1e12 or 1e150, far more bins beyond

@@ -723,39 +723,69 @@ bool KeepGoing(const ProgressFunction& progress, std::int64_t i, std::int64_t co
     progress(begin + (end - begin) * static_cast<double>(i) / static_cast<double>(count));
 }
 
-// Step 1: the histogram's range, the values' 0.5 and 99.5 percentiles (the exact voxels' when the
-// nodes carry them) widened to every seed sample.
-std::array<double, 2> HistogramRange(const CutProblem& pr)
+// Step 1: the histogram's bins on a lattice the image alone fixes: `base` bins (Bins, or
+// AutomaticBins) over the values' robust range, their 0.5 and 99.5 percentiles (the exact voxels'
+// when the nodes carry them), and `base` more of that width on each side. The histogram takes the
+// lattice's bins from the lowest to the highest seed sample's, and at least the robust range's;
+// beyond the lattice a sample counts in its end bin, as a node's value does. A seed edit then moves
+// only which bins the histogram spans, not their edges, so a re-cut keeps its nodes' voxels binned.
+struct HistogramLattice
+{
+  double Low = 0.0, Width = 1.0; // lattice bin j starts at Low + j Width
+  int Size = 0;                  // 3 base
+  int First = 0, Bins = 0;       // the histogram's bins: lattice bins [First, First + Bins)
+  double HistogramLow() const { return this->Low + this->First * this->Width; }
+  double HistogramHigh() const { return this->Low + (this->First + this->Bins) * this->Width; }
+};
+HistogramLattice MakeHistogramLattice(const CutProblem& pr, const BoykovJollyParameters& par)
 {
   const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
   const NodeVoxelValues* exact = pr.NodeVoxels;
-  double low = exact ? exact->Low : StridedPercentile(pr.Value.data(), n, 0.5);
+  const double low = exact ? exact->Low : StridedPercentile(pr.Value.data(), n, 0.5);
   double high = exact ? exact->High : StridedPercentile(pr.Value.data(), n, 99.5);
+  high = high > low ? high : low + 1.0;
+  const int base = par.Bins > 0
+    ? par.Bins
+    : AutomaticBins({ { &pr.ObjectSamples, &pr.ObjectWeights }, { &pr.BackgroundSamples, &pr.BackgroundWeights } }, low,
+        high, par.Bandwidth);
+  HistogramLattice lattice;
+  lattice.Width = (high - low) / base;
+  lattice.Low = low - base * lattice.Width;
+  lattice.Size = 3 * base;
+  double sampleLow = low, sampleHigh = high;
   for (const std::vector<double>* samples : { &pr.ObjectSamples, &pr.BackgroundSamples })
   {
     for (double v : *samples)
     {
-      low = std::min(low, v);
-      high = std::max(high, v);
+      sampleLow = std::min(sampleLow, v);
+      sampleHigh = std::max(sampleHigh, v);
     }
   }
-  return { { low, high > low ? high : low + 1.0 } };
+  const int below = static_cast<int>(std::min<double>(base, std::ceil((low - sampleLow) / lattice.Width)));
+  const int above = static_cast<int>(std::min<double>(base, std::ceil((sampleHigh - high) / lattice.Width)));
+  lattice.First = base - below;
+  lattice.Bins = base + below + above;
+  return lattice;
 }
 
-// Step 2: each label's cost -ln Pr(bin | label) from its seeds' smoothed histogram.
+// Step 2: each label's cost -ln Pr(bin | label) per lattice bin, from its seeds' smoothed histogram
+// (a lattice bin beyond the histogram takes its end bin's).
 struct BinCosts
 {
   std::vector<double> Object, Background;
 };
-BinCosts LabelBinCosts(const CutProblem& pr, double low, double high, int bins, double bandwidth)
+BinCosts LabelBinCosts(const CutProblem& pr, const HistogramLattice& lattice, double bandwidth)
 {
-  const std::vector<double> pObject = SmoothedHistogram(pr.ObjectSamples, pr.ObjectWeights, low, high, bins, bandwidth);
-  const std::vector<double> pBackground = SmoothedHistogram(pr.BackgroundSamples, pr.BackgroundWeights, low, high, bins, bandwidth);
-  BinCosts costs{ std::vector<double>(bins), std::vector<double>(bins) };
-  for (int b = 0; b < bins; ++b)
+  const double low = lattice.HistogramLow(), high = lattice.HistogramHigh();
+  const std::vector<double> pObject = SmoothedHistogram(pr.ObjectSamples, pr.ObjectWeights, low, high, lattice.Bins, bandwidth);
+  const std::vector<double> pBackground =
+    SmoothedHistogram(pr.BackgroundSamples, pr.BackgroundWeights, low, high, lattice.Bins, bandwidth);
+  BinCosts costs{ std::vector<double>(lattice.Size), std::vector<double>(lattice.Size) };
+  for (int j = 0; j < lattice.Size; ++j)
   {
-    costs.Object[b] = -std::log(pObject[b]);
-    costs.Background[b] = -std::log(pBackground[b]);
+    const int b = std::min(lattice.Bins - 1, std::max(0, j - lattice.First));
+    costs.Object[j] = -std::log(pObject[b]);
+    costs.Background[j] = -std::log(pBackground[b]);
   }
   return costs;
 }
@@ -814,7 +844,7 @@ bool BoundaryWeights(const CutProblem& pr, double sigma, BoundaryTerm& out, cons
 }
 
 // Step 4 for exact super-voxels: each node's region costs summed over its voxels' bins. The bins
-// move only when a seed sample leaves the last cut's range. Sorted values are summed straight from
+// move only when the bin count does. Sorted values are summed straight from
 // the values for a binning seen for the first time, and kept as runs once it repeats; bounded ones
 // are binned at once (a pass over the voxels), and the runs kept. False when progress asked to abort.
 bool ExactRegionCosts(const CutProblem& pr, const HistogramBins& bin, const BinCosts& costs, double low, double width,
@@ -1070,14 +1100,11 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     return r;
   }
   // 1-2. The histogram and each label's cost per bin.
-  const std::array<double, 2> range = HistogramRange(pr);
-  const double low = range[0], high = range[1];
-  r.Bins = par.Bins > 0 ? par.Bins
-                        : AutomaticBins({ { &pr.ObjectSamples, &pr.ObjectWeights }, { &pr.BackgroundSamples, &pr.BackgroundWeights } },
-                            low, high, par.Bandwidth);
-  const BinCosts costs = LabelBinCosts(pr, low, high, r.Bins, par.Bandwidth);
-  const double width = (high - low) / r.Bins;
-  const HistogramBins bin(r.Bins, low, width);
+  const HistogramLattice lattice = MakeHistogramLattice(pr, par);
+  r.Bins = lattice.Bins;
+  const BinCosts costs = LabelBinCosts(pr, lattice, par.Bandwidth);
+  const double low = lattice.Low, width = lattice.Width;
+  const HistogramBins bin(lattice.Size, low, width);
 
   // 3. The boundary term depends on the graph alone: a kept flow of this very graph holds its
   // weights in its residual graph (below).
@@ -1110,7 +1137,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   AdviseHugePages(regionBackground.get(), n * sizeof(double));
   if (aborted(RegionCosts(pr, bin, costs, low, width, cache ? &cache->Binned : nullptr, regionObject.get(),
         regionBackground.get(), SubProgress(progress, 0.2, 0.3))) ||
-    aborted(AddSeedGeodesicTerm(pr, high - low, cache ? &cache->Geodesic : nullptr, regionObject.get(), regionBackground.get(),
+    aborted(AddSeedGeodesicTerm(pr, lattice.HistogramHigh() - lattice.HistogramLow(), cache ? &cache->Geodesic : nullptr, regionObject.get(), regionBackground.get(),
       SubProgress(progress, 0.3, 0.33), r.GeodesicSeconds)) ||
     aborted(ScaleRegionCosts(par.Lambda, n, regionObject.get(), regionBackground.get(), total, SubProgress(progress, 0.33, 0.35))) ||
     aborted(progress(0.35)))

@@ -4,9 +4,11 @@
 //
 //   E(L) = lambda * sum_p size_p * -ln Pr(I_p | L_p) + sum_pq contact_pq * exp(-(I_p - I_q)^2 / 2 sigma^2) [L_p != L_q]
 //
-// Pr(I | object/background) is a kernel density estimate of the seed samples on a histogram over a
-// robust intensity range (0.5 to 99.5 percentiles of the node intensities, or of the voxel values
-// with the voxel region term), mixed with 1 % of a uniform density so that no intensity is impossible.
+// Pr(I | object/background) is a kernel density estimate of the seed samples on a histogram whose
+// bins the image fixes: their width divides a robust intensity range (0.5 to 99.5 percentiles of the
+// node intensities, or of the voxel values with the voxel region term), and the histogram spans that
+// range and every seed sample in bins of that width. It is mixed with 1 % of a uniform density so
+// that no intensity is impossible.
 // With the voxel region term (NodeVoxels set) a super-voxel's region cost is the sum of its voxels'
 // costs, so for region terms the super-voxel cut is the voxel cut restricted to labellings that are
 // constant on elements.
@@ -26,7 +28,8 @@ namespace featuremesh
 {
 struct BoykovJollyParameters
 {
-  // Histogram bins; 0 = automatic (AutomaticBins: 64, or more when the seeds' densities need them).
+  // Histogram bins over the robust intensity range (the histogram adds bins of their width to reach
+  // seed samples beyond it); 0 = automatic (AutomaticBins: 64, or more when the seeds' densities need them).
   int Bins = 0;
   // Boundary-term sigma (intensity units); 0 = automatic: the root mean square of the intensity
   // differences over all graph edges.
@@ -155,8 +158,8 @@ int AutomaticBins(const std::vector<WeightedSamples>& samples, double low, doubl
 // What one cut keeps for the next cut of the same graph and node voxels. The max-flow (Kohli and
 // Torr's dynamic graph cuts): when the next cut differs only in terminal capacities (a seed edit), it
 // starts from this flow and its search trees instead of from zero; any other change starts afresh.
-// The node voxels as runs of the histogram's bins, once a binning repeats (the bins move only when
-// a seed sample leaves the last range; bounded node voxels are binned at once): the voxel region
+// The node voxels as runs of the histogram's bins, once a binning repeats (the bins' edges depend on
+// the image and the bin count alone; bounded node voxels are binned at once): the voxel region
 // term then costs a read per bin a node spans. Not for sharing between threads.
 class MaxFlowCache
 {
