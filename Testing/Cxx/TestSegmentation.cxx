@@ -969,7 +969,7 @@ TEST(SeedGeodesics, KeptDistancesEqualFreshOnes)
 TEST(SeedGeodesics, KeptDistancesAtANewScaleEqualFreshOnes)
 {
   // The intensity unit moves from cut to cut (a seed sample beyond the histogram's range widens it),
-  // with and without seed edits: the kept distances, summed again along their paths and repaired
+  // with and without seed edits: the kept distances, weighed again from their paths' sums and repaired
   // where an edge now shortens them, equal those computed afresh at that scale.
   const NoisyGridGraph grid(9);
   const ImageGeometry& g = grid.g;

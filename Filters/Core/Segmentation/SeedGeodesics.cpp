@@ -128,14 +128,6 @@ private:
   std::size_t First = 0; // the first entry in Storage
 };
 
-// A path of length d at p extended to its neighbour q: the intensity step in units of the range,
-// plus the travel.
-inline double Extended(double d, const double* value, std::int64_t p, std::int64_t q, double step, double inverseScale,
-  double lengthWeight)
-{
-  return d + std::fabs(value[q] - value[p]) * inverseScale + lengthWeight * step;
-}
-
 // A radix heap (Ahuja, Mehlhorn, Orlin & Tarjan 1990) of 8-byte entries, a 32-bit key above a
 // 32-bit node: Dijkstra pops keys that never decrease, so an entry is filed by the highest bit in
 // which its key differs from the last key popped, and each entry moves down at most 32 times
@@ -188,13 +180,43 @@ struct DistanceField
 {
   std::vector<double> Distance;
   std::vector<std::int32_t> Root;   // -1 unreachable (fewer than 2^31 nodes)
-  // Kept fields only (a new scale rescales them): the previous node on each path, -1 at seeds and
-  // unreachable nodes, and the length of the edge from it (the adjacency's float).
-  bool KeepsPaths = false;
-  std::vector<std::int32_t> Parent;
-  std::vector<float> ParentStep;
+  // Kept fields only (a new scale rescales them): each node's shortest path as its two sums, the
+  // intensity steps (image units) and the travel (the adjacency's float steps), its distance
+  // Intensity / Scale + lengthWeight x Travel; a new scale weighs them again in one pass.
+  bool KeepsSums = false;
+  std::vector<double> Intensity, Travel;
   double Scale = 0.0;               // the intensity unit the distances are in
 };
+
+// Relaxes the edge p -> q (of length `step`) in `field` at `inverse` = 1 / scale: true when it
+// shortens q's distance, which it then takes with p's root (and its sums, kept).
+inline bool Relax(DistanceField& field, const double* value, std::int64_t p, std::int64_t q, double step, double inverse,
+  double lengthWeight)
+{
+  const double rise = std::fabs(value[q] - value[p]);
+  if (!field.KeepsSums)
+  {
+    const double candidate = field.Distance[p] + rise * inverse + lengthWeight * step;
+    if (candidate < field.Distance[q])
+    {
+      field.Distance[q] = candidate;
+      field.Root[q] = field.Root[p];
+      return true;
+    }
+    return false;
+  }
+  const double intensity = field.Intensity[p] + rise, travel = field.Travel[p] + step;
+  const double candidate = intensity * inverse + lengthWeight * travel;
+  if (candidate < field.Distance[q])
+  {
+    field.Distance[q] = candidate;
+    field.Root[q] = field.Root[p];
+    field.Intensity[q] = intensity;
+    field.Travel[q] = travel;
+    return true;
+  }
+  return false;
+}
 
 // Dijkstra into `field` from `seeds` (distance 0) and from `start` (nodes whose distances `field`
 // already holds); every other distance it holds must be exact for the seeds it came from, or
@@ -210,10 +232,10 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   {
     field.Distance.assign(n, std::numeric_limits<double>::infinity());
     field.Root.assign(n, -1);
-    if (field.KeepsPaths)
+    if (field.KeepsSums)
     {
-      field.Parent.assign(n, -1);
-      field.ParentStep.assign(n, 0.0f);
+      field.Intensity.assign(n, 0.0);
+      field.Travel.assign(n, 0.0);
     }
   }
   field.Scale = scale;
@@ -235,9 +257,10 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   {
     distance[p] = 0.0;
     field.Root[p] = static_cast<std::int32_t>(p);
-    if (field.KeepsPaths)
+    if (field.KeepsSums)
     {
-      field.Parent[p] = -1;
+      field.Intensity[p] = 0.0;
+      field.Travel[p] = 0.0;
     }
     heap.Push(key(0.0, p));
   }
@@ -260,101 +283,53 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
     {
       return false;
     }
-    const std::int32_t root = field.Root[p];
     adjacency.ForEach(p, [&](std::int64_t q, double step) {
-      const double candidate = Extended(d, value, p, q, step, inverse, lengthWeight);
-      if (candidate < distance[q])
+      if (Relax(field, value, p, q, step, inverse, lengthWeight))
       {
-        distance[q] = candidate;
-        field.Root[q] = root;
-        if (field.KeepsPaths)
-        {
-          field.Parent[q] = static_cast<std::int32_t>(p);
-          field.ParentStep[q] = static_cast<float>(step);
-        }
-        heap.Push(key(candidate, q));
+        heap.Push(key(distance[q], q));
       }
     });
   }
   return true;
 }
 
-// `field` (exact at field.Scale) made exact at `scale` for the same seeds. Each node's distance is
-// first summed again along its kept path, edge by edge as Dijkstra sums it (each node keeps the
-// length of the edge it came by): an upper bound, exact
-// where the path stays shortest. Then every node that some edge now shortens starts Dijkstra.
-// False when progress asks to abort. A field without paths is emptied, to start afresh; so is one
-// whose path is not acyclic, which cannot happen (a node's previous node is set only when it
-// strictly shortens its distance).
+// `field` (exact at field.Scale) made exact at `scale` for the same seeds. Each node's kept path is
+// weighed again from its sums: an upper bound, exact where the path stays shortest. Then every node
+// that some edge now shortens starts Dijkstra. False when progress asks to abort. A field without
+// sums is emptied, to start afresh.
 bool Rescale(const GeodesicGraph& g, const Adjacency& adjacency, double scale, double lengthWeight,
   DistanceField& field, const ProgressFunction& progress)
 {
   const std::int64_t n = g.Nodes();
-  if (!field.KeepsPaths)
+  if (!field.KeepsSums)
   {
     field = DistanceField();
     return true;
   }
   const double* value = g.Value.data();
   const double inverse = 1.0 / scale;
-  // In place: a node's old distance is read only at the root of its path (a seed, 0, or an
-  // unreachable node, infinity), before it is written; `done` marks the new ones.
   std::vector<double>& distance = field.Distance;
-  std::vector<std::uint64_t> done((n + 63) / 64, 0);
-  auto isDone = [&](std::int64_t q) { return (done[q >> 6] >> (q & 63)) & 1u; };
-  auto markDone = [&](std::int64_t q) { done[q >> 6] |= std::uint64_t(1) << (q & 63); };
-  std::vector<std::int64_t> path;
   for (std::int64_t p = 0; p < n; ++p)
   {
-    // Up the kept path to a node already done, or to its seed; then down, summing.
-    std::int64_t q = p;
-    while (!isDone(q) && field.Parent[q] >= 0)
+    if (std::isfinite(distance[p]))
     {
-      path.push_back(q);
-      q = field.Parent[q];
-      if (static_cast<std::int64_t>(path.size()) > n)
-      {
-        field = DistanceField();
-        field.KeepsPaths = true;
-        return true;
-      }
+      distance[p] = field.Intensity[p] * inverse + lengthWeight * field.Travel[p];
     }
-    if (!isDone(q))
-    {
-      distance[q] = std::isfinite(distance[q]) ? 0.0 : std::numeric_limits<double>::infinity();
-      markDone(q);
-    }
-    for (auto c = path.rbegin(); c != path.rend(); ++c)
-    {
-      const std::int64_t from = field.Parent[*c];
-      distance[*c] = Extended(distance[from], value, from, *c, field.ParentStep[*c], inverse, lengthWeight);
-      markDone(*c);
-    }
-    path.clear();
   }
-  // Then every node some edge now shortens starts Dijkstra (`done` now marks the queued ones).
+  // Then every node some edge now shortens starts Dijkstra, once.
   std::vector<std::int64_t> start;
-  std::fill(done.begin(), done.end(), 0);
+  std::vector<std::uint64_t> queued((n + 63) / 64, 0);
   for (std::int64_t p = 0; p < n; ++p)
   {
-    const double d = distance[p];
-    if (!std::isfinite(d))
+    if (!std::isfinite(distance[p]))
     {
       continue;
     }
     adjacency.ForEach(p, [&](std::int64_t q, double step) {
-      const double candidate = Extended(d, value, p, q, step, inverse, lengthWeight);
-      if (candidate < distance[q])
+      if (Relax(field, value, p, q, step, inverse, lengthWeight) && !((queued[q >> 6] >> (q & 63)) & 1u))
       {
-        distance[q] = candidate;
-        field.Root[q] = field.Root[p];
-        field.Parent[q] = static_cast<std::int32_t>(p);
-        field.ParentStep[q] = static_cast<float>(step);
-        if (!isDone(q))
-        {
-          markDone(q);
-          start.push_back(q);
-        }
+        queued[q >> 6] |= std::uint64_t(1) << (q & 63);
+        start.push_back(q);
       }
     });
   }
@@ -395,10 +370,6 @@ bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::
       {
         field.Distance[p] = std::numeric_limits<double>::infinity();
         field.Root[p] = -1;
-        if (field.KeepsPaths)
-        {
-          field.Parent[p] = -1;
-        }
         orphans.push_back(p);
       }
     }
@@ -409,17 +380,7 @@ bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::
       adjacency.ForEach(p, [&](std::int64_t q, double step) {
         if (field.Root[q] >= 0)
         {
-          const double candidate = Extended(field.Distance[q], value, q, p, step, inverse, lengthWeight);
-          if (candidate < field.Distance[p])
-          {
-            field.Distance[p] = candidate;
-            field.Root[p] = field.Root[q];
-            if (field.KeepsPaths)
-            {
-              field.Parent[p] = static_cast<std::int32_t>(q);
-              field.ParentStep[p] = static_cast<float>(step);
-            }
-          }
+          Relax(field, value, q, p, step, inverse, lengthWeight);
         }
       });
       if (field.Root[p] >= 0)
@@ -520,7 +481,7 @@ std::shared_ptr<SeedGeodesicCache::Kept> SeedGeodesicCache::Take(const GeodesicG
   }
   for (DistanceField& field : kept->Field)
   {
-    field.KeepsPaths = field.KeepsPaths || cache != nullptr;
+    field.KeepsSums = field.KeepsSums || cache != nullptr;
   }
   if (cache)
   {

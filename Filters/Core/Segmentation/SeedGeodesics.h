@@ -50,8 +50,9 @@ std::vector<double> GeodesicDistances(const GeodesicGraph& graph, const std::vec
 
 // What the spatial term keeps for the next cut of the same graph (values, steps and length weight):
 // the adjacency, and per seed kind the seed nodes, their distances with the scale they are in, and
-// each node's root seed and previous node. A cut whose seeds of a kind are the kept ones, at the
-// kept scale, reuses their distances. A new scale sums each node's kept path again and runs
+// each node's root seed and the two sums of its path (intensity steps and travel: a kept distance is
+// intensity / scale + length weight x travel). A cut whose seeds of a kind are the kept ones, at the
+// kept scale, reuses their distances. A new scale weighs each node's sums again and runs
 // Dijkstra from the nodes an edge then shortens; added seeds run Dijkstra from themselves, bounded
 // by the kept distances (they only shrink); nodes rooted at a removed seed restart from their
 // neighbours that kept theirs. Any other change starts afresh. Not for sharing between threads.
