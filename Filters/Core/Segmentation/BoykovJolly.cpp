@@ -1,5 +1,4 @@
 #include "BoykovJolly.h"
-#include "Digest.h"
 #include "Memory.h"
 #include "Percentile.h"
 
@@ -425,73 +424,6 @@ void ThrowOutOfMemory(const char* what)
 // on fresh memory.
 constexpr std::int64_t CheckEvery = (std::int64_t(1) << 18) - 1;
 
-// Empty when every input of the energy is usable, else a sentence.
-std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progress, bool& aborted)
-{
-  const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
-  const GraphEdges& edges = pr.Edges;
-  const std::int64_t m = edges.Size();
-  if (n == 0)
-  {
-    return "the graph is empty.";
-  }
-  if (std::string size = GraphSizeProblem(n, m); !size.empty())
-  {
-    return size;
-  }
-  const auto& dims = edges.GridDims();
-  if ((!pr.Size.empty() && static_cast<std::int64_t>(pr.Size.size()) != n) ||
-    static_cast<std::int64_t>(pr.Hard.size()) != n || edges.Malformed() ||
-    (edges.IsGrid() && static_cast<std::int64_t>(dims[0]) * dims[1] * dims[2] != n) ||
-    (!pr.Contact.empty() && static_cast<std::int64_t>(pr.Contact.size()) != m) ||
-    (!pr.Step.empty() && static_cast<std::int64_t>(pr.Step.size()) != m) ||
-    (pr.NodeVoxels && (pr.NodeVoxels->Nodes != n || pr.NodeVoxels->Empty())))
-  {
-    return "the graph's arrays disagree in length.";
-  }
-  std::int64_t badValue = 0, badSize = 0, badEdge = 0;
-  for (std::int64_t p = 0; p < n; ++p)
-  {
-    badValue += Usable(pr.Value[p]) ? 0 : 1;
-  }
-  for (double size : pr.Size)
-  {
-    badSize += (std::isfinite(size) && size >= 0.0) ? 0 : 1;
-  }
-  // Grid edges are valid by construction.
-  const auto checkEdge = [&](std::int64_t e, std::int64_t a, std::int64_t b) {
-    badEdge += (a >= 0 && a < n && b >= 0 && b < n &&
-                 (pr.Contact.empty() || (std::isfinite(pr.Contact[e]) && pr.Contact[e] >= 0.0)) &&
-                 (pr.Step.empty() || (std::isfinite(pr.Step[e]) && pr.Step[e] >= 0.0)))
-      ? 0
-      : 1;
-  };
-  if (!edges.IsGrid() && !edges.ForEachUntil(checkEdge, [&](double t) { return progress(0.5 * t); }))
-  {
-    aborted = true;
-    return std::string();
-  }
-  for (const auto* samples : { &pr.ObjectSamples, &pr.BackgroundSamples })
-  {
-    for (double v : *samples)
-    {
-      badValue += Usable(v) ? 0 : 1;
-    }
-  }
-  if (badValue)
-  {
-    return UnusableIntensities(badValue);
-  }
-  if (badSize)
-  {
-    return std::to_string(badSize) + " node sizes (voxel counts) are negative or not finite.";
-  }
-  if (badEdge)
-  {
-    return std::to_string(badEdge) + " graph edges name missing nodes or have a negative or non-finite contact or length.";
-  }
-  return std::string();
-}
 } // namespace
 
 using Flow = maxflow::Graph_DDD;
@@ -500,11 +432,11 @@ using Flow = maxflow::Graph_DDD;
 struct MaxFlowCache::Kept
 {
   std::shared_ptr<Flow> Graph;
-  // The boundary term's inputs (explicit edge lists copied unless held, the values shared, the
-  // contacts by their digest: 64 MB at 512^3 that only this check would hold) and what it made of them.
+  // The boundary term's inputs (explicit edge lists copied unless held; the arrays shared, so a
+  // re-cut of the same arrays finds them by their storage) and what it made of them. The sizes and
+  // steps too: a problem whose arrays are all the kept ones was checked when they were kept.
   GraphEdges Edges;
-  SharedArray<double> Value;
-  std::uint64_t ContactDigest = 0;
+  SharedArray<double> Value, Contact, Size, Step;
   double SigmaParameter = 0.0, Sigma = 0.0, WeightTotal = 0.0;
   // The terminal capacities of the last flow.
   std::unique_ptr<double[]> Source, Sink;
@@ -531,6 +463,78 @@ struct MaxFlowCache::BinnedVoxels
 
 namespace
 {
+// Empty when every input of the energy is usable, else a sentence. The arrays of `checked` (the
+// last cut's, optional) are not read again.
+std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progress, bool& aborted,
+  const MaxFlowCache::Kept* checked)
+{
+  const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
+  const GraphEdges& edges = pr.Edges;
+  const std::int64_t m = edges.Size();
+  if (n == 0)
+  {
+    return "the graph is empty.";
+  }
+  if (std::string size = GraphSizeProblem(n, m); !size.empty())
+  {
+    return size;
+  }
+  const auto& dims = edges.GridDims();
+  if ((!pr.Size.empty() && static_cast<std::int64_t>(pr.Size.size()) != n) ||
+    static_cast<std::int64_t>(pr.Hard.size()) != n || edges.Malformed() ||
+    (edges.IsGrid() && static_cast<std::int64_t>(dims[0]) * dims[1] * dims[2] != n) ||
+    (!pr.Contact.empty() && static_cast<std::int64_t>(pr.Contact.size()) != m) ||
+    (!pr.Step.empty() && static_cast<std::int64_t>(pr.Step.size()) != m) ||
+    (pr.NodeVoxels && (pr.NodeVoxels->Nodes != n || pr.NodeVoxels->Empty())))
+  {
+    return "the graph's arrays disagree in length.";
+  }
+  const bool same = checked && checked->Value.SameStorage(pr.Value) && checked->Size.SameStorage(pr.Size) &&
+    checked->Contact.SameStorage(pr.Contact) && checked->Step.SameStorage(pr.Step) && checked->Edges.Same(edges);
+  std::int64_t badValue = 0, badSize = 0, badEdge = 0;
+  for (std::int64_t p = 0; p < n && !same; ++p)
+  {
+    badValue += Usable(pr.Value[p]) ? 0 : 1;
+  }
+  for (std::int64_t p = 0; p < static_cast<std::int64_t>(pr.Size.size()) && !same; ++p)
+  {
+    badSize += (std::isfinite(pr.Size[p]) && pr.Size[p] >= 0.0) ? 0 : 1;
+  }
+  // Grid edges are valid by construction.
+  const auto checkEdge = [&](std::int64_t e, std::int64_t a, std::int64_t b) {
+    badEdge += (a >= 0 && a < n && b >= 0 && b < n &&
+                 (pr.Contact.empty() || (std::isfinite(pr.Contact[e]) && pr.Contact[e] >= 0.0)) &&
+                 (pr.Step.empty() || (std::isfinite(pr.Step[e]) && pr.Step[e] >= 0.0)))
+      ? 0
+      : 1;
+  };
+  if (!edges.IsGrid() && !same && !edges.ForEachUntil(checkEdge, [&](double t) { return progress(0.5 * t); }))
+  {
+    aborted = true;
+    return std::string();
+  }
+  for (const auto* samples : { &pr.ObjectSamples, &pr.BackgroundSamples })
+  {
+    for (double v : *samples)
+    {
+      badValue += Usable(v) ? 0 : 1;
+    }
+  }
+  if (badValue)
+  {
+    return UnusableIntensities(badValue);
+  }
+  if (badSize)
+  {
+    return std::to_string(badSize) + " node sizes (voxel counts) are negative or not finite.";
+  }
+  if (badEdge)
+  {
+    return std::to_string(badEdge) + " graph edges name missing nodes or have a negative or non-finite contact or length.";
+  }
+  return std::string();
+}
+
 // The histogram's bins as the cut defines them, bin(v) = int((v - low) / width) clamped to
 // [0, count), with the smallest value of each bin found once (exactly: a binary search over the
 // doubles, in their order), so that sorted values split into runs by comparisons alone.
@@ -1046,13 +1050,12 @@ bool MaxFlow(const std::shared_ptr<Flow>& g, std::int64_t n, bool reuse, const P
 
 // Step 8: a new record of the graph a re-cut may reuse. Held edge lists are kept as they are, lists
 // only viewed are copied; the weights live in the graph's capacities only.
-std::shared_ptr<MaxFlowCache::Kept> NewKept(const CutProblem& pr, std::uint64_t contactDigest, double sigmaParameter,
-  double sigma, double weightTotal)
+std::shared_ptr<MaxFlowCache::Kept> NewKept(const CutProblem& pr, double sigmaParameter, double sigma, double weightTotal)
 {
   auto kept = std::make_shared<MaxFlowCache::Kept>();
   kept->Edges = pr.Edges.Keepable();
   kept->Value = pr.Value;
-  kept->ContactDigest = contactDigest;
+  kept->Contact = pr.Contact;
   kept->SigmaParameter = sigmaParameter;
   kept->Sigma = sigma;
   kept->WeightTotal = weightTotal;
@@ -1085,7 +1088,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
   const GraphEdges& edges = pr.Edges;
   const std::int64_t m = edges.Size();
-  r.Error = ValidateProblem(pr, SubProgress(progress, 0.0, 0.05), r.Aborted);
+  r.Error = ValidateProblem(pr, SubProgress(progress, 0.0, 0.05), r.Aborted, cache ? cache->State.get() : nullptr);
   if (!r.Error.empty() || r.Aborted)
   {
     return r;
@@ -1109,10 +1112,8 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   // 3. The boundary term depends on the graph alone: a kept flow of this very graph holds its
   // weights in its residual graph (below).
   std::shared_ptr<MaxFlowCache::Kept> kept = cache ? cache->State : nullptr;
-  const std::uint64_t contactDigest =
-    cache ? DigestBytes(DigestWord(DigestSeed, pr.Contact.size()), pr.Contact.data(), pr.Contact.size() * sizeof(double)) : 0;
   const bool reuse = kept && kept->SigmaParameter == par.Sigma && kept->Edges.Same(edges) && kept->Value == pr.Value &&
-    kept->ContactDigest == contactDigest;
+    kept->Contact == pr.Contact;
   BoundaryTerm boundary;
   if (reuse)
   {
@@ -1201,8 +1202,10 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   {
     if (!reuse)
     {
-      kept = NewKept(pr, contactDigest, par.Sigma, r.Sigma, total);
+      kept = NewKept(pr, par.Sigma, r.Sigma, total);
     }
+    kept->Size = pr.Size;
+    kept->Step = pr.Step;
     kept->Graph = g;
     // The capacities in place of the region costs they were made of (a node's read its own only).
     for (std::int64_t p = 0; p < n; ++p)

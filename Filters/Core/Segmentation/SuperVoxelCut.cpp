@@ -121,6 +121,7 @@ bool PrepareVoxelOwners(const SimplexMesh& mesh, SuperVoxelCutData& data, const 
     data.Owner.Own(VoxelOwners(ElementRasterizer(mesh), parallel, progress));
   }
   data.CentreSteps = CentreDistances(mesh, mesh.Faces());
+  data.Contact = ContactInVoxelFaces(mesh, true);
   return !data.Owner.empty();
 }
 
@@ -155,7 +156,9 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   const std::shared_ptr<const FaceAdjacency> faces = mesh.SharedFaces();
   const FaceAdjacency& adj = *faces;
   pr.Edges = GraphEdges(adj.A, adj.B, faces);
-  pr.Contact = ContactInVoxelFaces(mesh, parameters.ScaleByContact);
+  pr.Contact = parameters.ScaleByContact && data.Contact.size() == adj.A.size()
+    ? data.Contact
+    : SharedArray<double>(ContactInVoxelFaces(mesh, parameters.ScaleByContact));
   // Seed histograms: the voxels of the seed elements when the values are there, else their means
   // weighted by their voxel counts.
   if (data.HasVoxelValues())

@@ -119,6 +119,8 @@ struct SuperVoxelCutData
   // CentreDistances of the mesh, for the geodesic spatial term (made by PrepareVoxelOwners); the
   // cuts' problems and caches share it.
   SharedArray<double> CentreSteps;
+  // ContactInVoxelFaces of the mesh, scaled (made by PrepareVoxelOwners), shared the same way.
+  SharedArray<double> Contact;
   bool HasVoxelValues() const { return !this->Voxels.Empty(); }
 };
 
