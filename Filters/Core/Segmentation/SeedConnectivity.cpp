@@ -10,7 +10,8 @@ namespace featuremesh
 {
 namespace
 {
-std::int64_t Find(std::vector<std::int64_t>& parent, std::int64_t p)
+template <typename Index>
+Index Find(std::vector<Index>& parent, Index p)
 {
   while (parent[p] != p)
   {
@@ -19,19 +20,22 @@ std::int64_t Find(std::vector<std::int64_t>& parent, std::int64_t p)
   }
   return p;
 }
-} // namespace
 
-std::vector<std::int64_t> LabelComponents(
-  const std::vector<std::uint8_t>& label, const GraphEdges& edges, std::int64_t& count, const ProgressFunction& progress)
+// Union-find over the nodes in `Index` (32-bit ids halve the memory the finds wander through on
+// graphs under 2^31 nodes).
+template <typename Index>
+bool Components(const std::vector<std::uint8_t>& label, const GraphEdges& edges, std::vector<std::int64_t>& id,
+  std::int64_t& count, std::vector<std::int64_t>* between, const ProgressFunction& progress)
 {
-  const std::int64_t n = static_cast<std::int64_t>(label.size());
-  std::vector<std::int64_t> parent;
+  const Index n = static_cast<Index>(label.size());
+  std::vector<Index> parent;
   AssignFresh(parent, static_cast<std::size_t>(n));
-  std::iota(parent.begin(), parent.end(), std::int64_t(0));
-  const auto unite = [&](std::int64_t, std::int64_t p, std::int64_t q) {
+  std::iota(parent.begin(), parent.end(), Index(0));
+  const auto unite = [&](std::int64_t, std::int64_t p64, std::int64_t q64) {
+    const Index p = static_cast<Index>(p64), q = static_cast<Index>(q64);
     if (label[p] == label[q])
     {
-      std::int64_t a = Find(parent, p), b = Find(parent, q);
+      Index a = Find(parent, p), b = Find(parent, q);
       if (a != b)
       {
         // The smaller root wins, so a component's root is its first node whatever the edge order.
@@ -42,22 +46,40 @@ std::vector<std::int64_t> LabelComponents(
         parent[b] = a;
       }
     }
+    else if (between)
+    {
+      between->push_back(p64);
+      between->push_back(q64);
+    }
   };
   if (!edges.ForEachUntil(unite, [&](double t) { return progress(0.9 * t); }))
   {
-    return {};
-  }
-  for (std::int64_t p = 0; p < n; ++p)
-  {
-    parent[p] = Find(parent, p);
+    return false;
   }
   // Every root is its component's smallest node, so it is numbered before its other nodes.
+  AssignFresh(id, static_cast<std::size_t>(n));
   count = 0;
-  for (std::int64_t p = 0; p < n; ++p)
+  for (Index p = 0; p < n; ++p)
   {
-    parent[p] = parent[p] == p ? count++ : parent[parent[p]];
+    const Index r = Find(parent, p);
+    id[p] = r == p ? count++ : id[r];
   }
-  return parent;
+  return true;
+}
+} // namespace
+
+std::vector<std::int64_t> LabelComponents(const std::vector<std::uint8_t>& label, const GraphEdges& edges,
+  std::int64_t& count, const ProgressFunction& progress, std::vector<std::int64_t>* between)
+{
+  std::vector<std::int64_t> id;
+  if (between)
+  {
+    between->clear();
+  }
+  const bool done = label.size() < (std::size_t(1) << 31)
+    ? Components<std::int32_t>(label, edges, id, count, between, progress)
+    : Components<std::int64_t>(label, edges, id, count, between, progress);
+  return done ? id : std::vector<std::int64_t>();
 }
 
 std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label, const GraphEdges& edges,
@@ -73,7 +95,8 @@ std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& lab
   // whole components, over the (few) edges between labels.
   const std::int64_t n = static_cast<std::int64_t>(label.size());
   std::int64_t count = 0;
-  const std::vector<std::int64_t> id = LabelComponents(label, edges, count, SubProgress(progress, 0.0, 0.8));
+  std::vector<std::int64_t> between;
+  const std::vector<std::int64_t> id = LabelComponents(label, edges, count, SubProgress(progress, 0.0, 0.8), &between);
   if (static_cast<std::int64_t>(id.size()) != n)
   {
     return -1;
@@ -95,14 +118,12 @@ std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& lab
     }
   }
   // Components meeting across an edge: always of different labels.
-  std::vector<std::pair<std::int64_t, std::int64_t>> meet;
-  edges.ForEach([&](std::int64_t, std::int64_t p, std::int64_t q) {
-    const std::int64_t a = id[p], b = id[q];
-    if (a != b)
-    {
-      meet.emplace_back(std::min(a, b), std::max(a, b));
-    }
-  });
+  std::vector<std::pair<std::int64_t, std::int64_t>> meet(between.size() / 2);
+  for (std::size_t e = 0; e < meet.size(); ++e)
+  {
+    const std::int64_t a = id[between[2 * e]], b = id[between[2 * e + 1]];
+    meet[e] = { std::min(a, b), std::max(a, b) };
+  }
   std::sort(meet.begin(), meet.end());
   meet.erase(std::unique(meet.begin(), meet.end()), meet.end());
   if (!progress(0.9))

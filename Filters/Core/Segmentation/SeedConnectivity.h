@@ -42,9 +42,10 @@ inline Connectivity ConnectivityFor(Connectivity mode, Task task)
 
 // Components of equal label over the graph's edges: an id per node, numbered in order of each
 // component's first node (deterministic); `count` receives their number. Empty when `progress`
-// (asked every 2^18 edges: a voxel graph has tens of millions) aborts.
+// (asked every 2^18 edges: a voxel graph has tens of millions) aborts. `between` (optional)
+// receives the edges between different labels as node pairs (p, q, p, q, ...), in edge order.
 std::vector<std::int64_t> LabelComponents(const std::vector<std::uint8_t>& label, const GraphEdges& edges,
-  std::int64_t& count, const ProgressFunction& progress = NoProgress());
+  std::int64_t& count, const ProgressFunction& progress = NoProgress(), std::vector<std::int64_t>* between = nullptr);
 
 // Applies `mode` to `label` (1 object, 0 background) in place; `hard` (0 free, 1 object seed, 2
 // background seed) and `border` (node touches the image border) per node. Seeded nodes keep their
