@@ -146,52 +146,24 @@ int vtkSuperVoxelCut::RequestData(
     {
       return done;
     }
-    // The image frame: the Image input when connected, else the mesh's field data.
-    std::string error = ImageMeshProblem(input);
-    if (!error.empty())
-    {
-      return this->Fail(error);
-    }
     ImageGeometry geometry;
-    if (image ? !ImageGeometryOf(image, geometry, error) || !MeshMatchesImage(input, geometry, error)
-              : !ImageGeometryFromFieldData(input, geometry, error))
+    vtkDataArray* valuesArray = nullptr;
+    vtkDataArray* binaryValues = nullptr;
+    bool contrast = false;
+    if (const int done = this->ReadImage(input, image, labelledSeeds != nullptr, geometry, valuesArray, binaryValues, contrast);
+        done >= 0)
     {
-      return this->Fail(image ? error : error + " Or connect the Image input.");
-    }
-    vtkDataArray* valuesArray = image ? this->ChosenImageArray(image, this->GetInputArrayInformation(0)) : nullptr;
-    if (image && !valuesArray)
-    {
-      return 0;
-    }
-    const bool contrast = UsesLocalContrast(*this);
-    if (contrast && !valuesArray && this->featuremesh::SeededCutParameters::Intensity == CutIntensity::LocalContrast)
-    {
-      return this->Fail("the local contrast is read from the image: connect the Image input.");
-    }
-    if (contrast && !valuesArray)
-    {
-      this->Warn("Task Class reads the image's local contrast; without the Image input the cut reads the elements' MeanIntensity.");
-    }
-    valuesArray = CutValues(valuesArray, contrast, geometry, this->ContrastScale, this->Contrast, error);
-    if (image && !valuesArray)
-    {
-      return this->Fail(error);
+      return done;
     }
     if (!labelledSeeds && (!objectSeeds || !backgroundSeeds))
     {
       return this->Fail("connect the Object Seeds and the Background Seeds, or labelled Seeds.");
     }
-    // A multi-channel image serves labelled seeds only; the binary preparation leaves it out.
-    vtkDataArray* binaryValues = valuesArray && valuesArray->GetNumberOfComponents() == 1 ? valuesArray : nullptr;
-    if (valuesArray && !binaryValues && !labelledSeeds)
-    {
-      return this->Fail("the image array has " + std::to_string(valuesArray->GetNumberOfComponents()) +
-        " components; a binary cut takes one (choose a one-component array), labelled Seeds take several.");
-    }
     if (const int done = this->Prepare(input, geometry, valuesArray, binaryValues, contrast && binaryValues); done >= 0)
     {
       return done;
     }
+    std::string error;
     std::vector<std::int64_t> objectVoxels, backgroundVoxels;
     if (labelledSeeds)
     {
@@ -250,6 +222,50 @@ void vtkSuperVoxelCut::WriteCutFields(
                         { names::GraphSeconds, cut.GraphSeconds }, { names::FlowSeconds, cut.FlowSeconds },
                         { names::GeodesicSeconds, cut.GeodesicSeconds }, { names::CutTotalSeconds, this->Seconds() } });
   }
+}
+
+int vtkSuperVoxelCut::ReadImage(vtkUnstructuredGrid* input, vtkImageData* image, bool labelled,
+  featuremesh::ImageGeometry& geometry, vtkDataArray*& valuesArray, vtkDataArray*& binaryValues, bool& contrast)
+{
+  using namespace featuremesh;
+  // The image frame: the Image input when connected, else the mesh's field data.
+  std::string error = ImageMeshProblem(input);
+  if (!error.empty())
+  {
+    return this->Fail(error);
+  }
+  if (image ? !ImageGeometryOf(image, geometry, error) || !MeshMatchesImage(input, geometry, error)
+            : !ImageGeometryFromFieldData(input, geometry, error))
+  {
+    return this->Fail(image ? error : error + " Or connect the Image input.");
+  }
+  valuesArray = image ? this->ChosenImageArray(image, this->GetInputArrayInformation(0)) : nullptr;
+  if (image && !valuesArray)
+  {
+    return 0;
+  }
+  contrast = UsesLocalContrast(*this);
+  if (contrast && !valuesArray && this->featuremesh::SeededCutParameters::Intensity == CutIntensity::LocalContrast)
+  {
+    return this->Fail("the local contrast is read from the image: connect the Image input.");
+  }
+  if (contrast && !valuesArray)
+  {
+    this->Warn("Task Class reads the image's local contrast; without the Image input the cut reads the elements' MeanIntensity.");
+  }
+  valuesArray = CutValues(valuesArray, contrast, geometry, this->ContrastScale, this->Contrast, error);
+  if (image && !valuesArray)
+  {
+    return this->Fail(error);
+  }
+  // A multi-channel image serves labelled seeds only; the binary preparation leaves it out.
+  binaryValues = valuesArray && valuesArray->GetNumberOfComponents() == 1 ? valuesArray : nullptr;
+  if (valuesArray && !binaryValues && !labelled)
+  {
+    return this->Fail("the image array has " + std::to_string(valuesArray->GetNumberOfComponents()) +
+      " components; a binary cut takes one (choose a one-component array), labelled Seeds take several.");
+  }
+  return -1;
 }
 
 int vtkSuperVoxelCut::Prepare(vtkUnstructuredGrid* input, const featuremesh::ImageGeometry& geometry,

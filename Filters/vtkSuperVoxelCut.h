@@ -30,6 +30,7 @@
 #include <vector>
 
 class vtkDataArray;
+class vtkImageData;
 namespace featuremesh
 {
 class LocalContrastArray;
@@ -138,6 +139,11 @@ private:
     const std::vector<std::int64_t>& boundaryFaces, vtkInformationVector* outputVector);
   // Output 2's voxel labels, in an array the filter keeps for the next cut.
   vtkUnsignedCharArray* LabelVoxels(const std::vector<std::uint8_t>& labels);
+  // The image frame (the Image input, else the mesh's field data) and the values the cut reads:
+  // -1 to go on, else RequestData's result. `binaryValues` is `valuesArray` when it has one
+  // component; several serve labelled seeds only.
+  int ReadImage(vtkUnstructuredGrid* input, vtkImageData* image, bool labelled, featuremesh::ImageGeometry& geometry,
+    vtkDataArray*& valuesArray, vtkDataArray*& binaryValues, bool& contrast);
   // Makes (or keeps, for a seed edit) the mesh-dependent data: -1 to go on, else RequestData's result.
   // With `voxelMeans` the elements' intensities are the means of `binaryValues` over their voxels
   // (the local contrast), not the mesh's MeanIntensity.
