@@ -492,13 +492,16 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
   const bool same = checked && checked->Value.SameStorage(pr.Value) && checked->Size.SameStorage(pr.Size) &&
     checked->Contact.SameStorage(pr.Contact) && checked->Step.SameStorage(pr.Step) && checked->Edges.Same(edges);
   std::int64_t badValue = 0, badSize = 0, badEdge = 0;
-  for (std::int64_t p = 0; p < n && !same; ++p)
+  if (!same)
   {
-    badValue += Usable(pr.Value[p]) ? 0 : 1;
-  }
-  for (std::int64_t p = 0; p < static_cast<std::int64_t>(pr.Size.size()) && !same; ++p)
-  {
-    badSize += (std::isfinite(pr.Size[p]) && pr.Size[p] >= 0.0) ? 0 : 1;
+    for (double v : pr.Value)
+    {
+      badValue += Usable(v) ? 0 : 1;
+    }
+    for (double size : pr.Size)
+    {
+      badSize += (std::isfinite(size) && size >= 0.0) ? 0 : 1;
+    }
   }
   // Grid edges are valid by construction.
   const auto checkEdge = [&](std::int64_t e, std::int64_t a, std::int64_t b) {

@@ -836,8 +836,7 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
       }
     }
   });
-  const SharedArray<double> step =
-    data.CentreSteps.size() == faces->A.size() ? data.CentreSteps : SharedArray<double>(CentreDistances(mesh, *faces));
+  const SharedArray<double> step = MeshCentreSteps(mesh, data);
   std::vector<std::uint8_t> border(n, 0);
   for (std::int64_t e : faces->HullElement)
   {
@@ -860,7 +859,8 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
     cache->WeightContact = par.ScaleByContact;
   }
   const bool weighted = cache && static_cast<std::int64_t>(cache->Weight.size()) == edges.Size();
-  SolveLabels(pr, hard, mean, bins, step, weighted ? std::vector<double>() : ContactInVoxelFaces(mesh, par.ScaleByContact),
+  const SharedArray<double> contact = weighted ? SharedArray<double>() : MeshContact(mesh, data, par.ScaleByContact);
+  SolveLabels(pr, hard, mean, bins, step, contact.Vector(),
     count, border, par, multi, std::move(start), parallel, progress, cache, t0, r);
   if (!r.Error.empty() || r.Aborted)
   {

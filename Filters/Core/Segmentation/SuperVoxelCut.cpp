@@ -113,6 +113,18 @@ std::vector<double> ContactInVoxelFaces(const SimplexMesh& mesh, bool scale)
   return contact;
 }
 
+SharedArray<double> MeshCentreSteps(const SimplexMesh& mesh, const SuperVoxelCutData& data)
+{
+  const FaceAdjacency& adj = mesh.Faces();
+  return data.CentreSteps.size() == adj.A.size() ? data.CentreSteps : SharedArray<double>(CentreDistances(mesh, adj));
+}
+
+SharedArray<double> MeshContact(const SimplexMesh& mesh, const SuperVoxelCutData& data, bool scale)
+{
+  return scale && data.Contact.size() == mesh.Faces().A.size() ? data.Contact
+                                                                 : SharedArray<double>(ContactInVoxelFaces(mesh, scale));
+}
+
 bool PrepareVoxelOwners(const SimplexMesh& mesh, SuperVoxelCutData& data, const ParallelFor& parallel,
   const ProgressFunction& progress)
 {
@@ -156,9 +168,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   const std::shared_ptr<const FaceAdjacency> faces = mesh.SharedFaces();
   const FaceAdjacency& adj = *faces;
   pr.Edges = GraphEdges(adj.A, adj.B, faces);
-  pr.Contact = parameters.ScaleByContact && data.Contact.size() == adj.A.size()
-    ? data.Contact
-    : SharedArray<double>(ContactInVoxelFaces(mesh, parameters.ScaleByContact));
+  pr.Contact = MeshContact(mesh, data, parameters.ScaleByContact);
   // Seed histograms: the voxels of the seed elements when the values are there, else their means
   // weighted by their voxel counts.
   if (data.HasVoxelValues())
@@ -208,7 +218,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   if (parameters.Task == Task::Object)
   {
     pr.Geodesic = parameters.Geodesic;
-    pr.Step = data.CentreSteps.size() == adj.A.size() ? data.CentreSteps : SharedArray<double>(CentreDistances(mesh, adj));
+    pr.Step = MeshCentreSteps(mesh, data);
   }
   result.SetupSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
   result.Cut = BoykovJollyCut(pr, parameters, progress, flow);

@@ -124,6 +124,11 @@ struct SuperVoxelCutData
   bool HasVoxelValues() const { return !this->Voxels.Empty(); }
 };
 
+// The mesh's centre steps and contacts as `data` keeps them, else made afresh (a mesh prepared
+// without them): what both cuts put in their problems.
+SharedArray<double> MeshCentreSteps(const SimplexMesh& mesh, const SuperVoxelCutData& data);
+SharedArray<double> MeshContact(const SimplexMesh& mesh, const SuperVoxelCutData& data, bool scale);
+
 // The element owning each voxel into `data.Owner`, by rasterising the mesh unless it already holds
 // them (stage 2's, say). False when progress asked to abort.
 bool PrepareVoxelOwners(const SimplexMesh& mesh, SuperVoxelCutData& data, const ParallelFor& parallel,
