@@ -1,4 +1,5 @@
 #include "vtkSuperVoxelCut.h"
+#include "Memory.h"
 
 #include "Contract.h"
 #include "MultiLabelCut.h"
@@ -400,10 +401,20 @@ vtkUnsignedCharArray* vtkSuperVoxelCut::LabelVoxels(const std::vector<std::uint8
   if (slot < 0)
   {
     slot = 1 - last; // both held elsewhere, or none yet: a new array
-    data.LabelImages[slot].Voxels = vtkSmartPointer<vtkUnsignedCharArray>::New();
-    data.LabelImages[slot].Voxels->SetName(names::Label);
-    data.LabelImages[slot].Voxels->SetNumberOfTuples(size);
-    data.LabelImages[slot].Labels.clear();
+    MeshData::LabelImage& fresh = data.LabelImages[slot];
+    fresh.Voxels = vtkSmartPointer<vtkUnsignedCharArray>::New();
+    fresh.Voxels->SetName(names::Label);
+    fresh.Voxels->SetNumberOfTuples(size);
+    AdviseHugePages(fresh.Voxels->GetPointer(0), static_cast<std::size_t>(size));
+    fresh.Labels.clear();
+    // A copy of the last image (held, e.g. by a view) is patched like a kept one: a copy streams
+    // 1 byte per voxel, the full labelling reads the 4-byte owner map as well.
+    const MeshData::LabelImage& held = data.LabelImages[last];
+    if (held.Voxels && held.Voxels->GetNumberOfTuples() == size && !held.Labels.empty())
+    {
+      std::copy_n(held.Voxels->GetPointer(0), size, fresh.Voxels->GetPointer(0));
+      fresh.Labels = held.Labels;
+    }
   }
   MeshData::LabelImage& image = data.LabelImages[slot];
   if (!PatchVoxelLabels(data.Mesh, data.Cut.Owner, image.Labels, labels, image.Voxels->GetPointer(0), SMPParallelFor()))

@@ -83,7 +83,17 @@ ft.check(cached(labels, vtkAbstractArray.PER_COMPONENT()) is None and labels.Get
          "a changed label image drops its cached range, and VTK computes the new one")
 
 # A re-cut rewrites the label image of the cut before last in place (the one no one holds): its range
-# must follow. Labels 1..k kept, k = 5, 3, 4, 2: the third cut rewrites the first one's image.
+# must follow, and its values too. Labels 1..k kept, k = 5, 3, 4, 2: the third cut rewrites the first
+# one's image.
+
+
+def on_voxels(cut, voxels):
+    """Whether a cut's label image holds each voxel's element label (0 outside the mesh)."""
+    owner = ft.fm.v2n(ft.fm.owner_map(mesh))
+    cells = ft.fm.v2n(cut.GetClientSideObject().GetOutputDataObject(0).GetCellData().GetArray(ft.names.Label))
+    return ft.np.array_equal(ft.fm.v2n(voxels), ft.np.where(owner >= 0, cells[ft.np.maximum(owner, 0)], 0))
+
+
 abdomen = os.path.join(ft.DATA, "multilabel", "abdomen-ct-totalseg")
 if os.path.isdir(abdomen):
     image = ps.OpenDataFile(os.path.join(abdomen, "image.mha"))
@@ -104,4 +114,19 @@ if os.path.isdir(abdomen):
         shown = multi.GetDataInformation(2).GetPointDataInformation().GetArrayInformation(ft.names.Label).GetComponentRange(0)
         ft.check(tuple(shown) == (0.0, float(k)) and computed(voxels)[0] == [(0.0, float(k))],
                  "abdomen, labels 0..%d: ParaView shows the label image's range %s" % (k, tuple(shown)))
+        ft.check(on_voxels(multi, voxels), "abdomen, labels 0..%d: the label image is the elements' labels on their voxels" % k)
+    # A new cut's first re-cut, its image held (as a view holds it): a copy of it patched where the
+    # first seed, moved by a voxel, changed labels.
+    edited = rows[rows[:, 3] <= 2].copy()
+    for step in (0, 1):
+        edited[0, 0] += step * ft.fm.fetch(image).GetSpacing()[0]
+        path = os.path.join(folder, "edited_%d.csv" % step)
+        ft.np.savetxt(path, edited, delimiter=",", header="x,y,z,label", comments="", fmt="%g")
+        if step == 0:
+            fresh = ps.SuperVoxelCut(Mesh=mesh, Seeds=ps.CSVReader(FileName=[path]), Image=image)
+        else:
+            fresh.Seeds = ps.CSVReader(FileName=[path])
+        fresh.UpdatePipeline()
+        held = fresh.GetClientSideObject().GetOutputDataObject(2).GetPointData().GetArray(ft.names.Label)
+        ft.check(on_voxels(fresh, held), "abdomen, a seed moved (%d): the label image is the elements' labels" % step)
 ft.finish("value range")
