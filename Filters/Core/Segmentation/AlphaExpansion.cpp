@@ -20,7 +20,34 @@ void ThrowOutOfMemory(const char* what)
   throw std::runtime_error(std::string("max-flow: ") + what);
 }
 
-std::string Validate(const PottsProblem& pr)
+// Loops over fixed blocks of nodes (or of the edges' blocks), so that a sum adds its blocks' partial
+// sums in block order and comes out the same for any thread count.
+constexpr std::int64_t NodeBlock = 16384;
+
+std::int64_t NodeBlocks(const PottsProblem& pr)
+{
+  return (pr.Nodes + NodeBlock - 1) / NodeBlock;
+}
+
+template <typename F>
+void ForBlocks(const ParallelFor& parallel, std::int64_t blocks, F&& f)
+{
+  parallel(blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+    for (std::int64_t b = b0; b < b1; ++b)
+    {
+      f(b);
+    }
+  });
+}
+
+template <typename F>
+void ForNodeBlocks(const PottsProblem& pr, const ParallelFor& parallel, F&& f)
+{
+  ForBlocks(parallel, NodeBlocks(pr),
+    [&](std::int64_t b) { f(b, b * NodeBlock, std::min(pr.Nodes, (b + 1) * NodeBlock)); });
+}
+
+std::string Validate(const PottsProblem& pr, const ParallelFor& parallel)
 {
   if (pr.Labels < 2 || pr.Labels > 256)
   {
@@ -40,48 +67,73 @@ std::string Validate(const PottsProblem& pr)
   {
     return "the costs, weights or hard labels do not match the graph.";
   }
-  for (double c : pr.Cost)
-  {
-    if (!std::isfinite(c) || std::fabs(c) > 1e150)
+  enum : std::uint8_t { BadCost = 1, BadWeight = 2, BadHard = 4, BadEnd = 8 };
+  std::vector<std::uint8_t> nodeBad(NodeBlocks(pr), 0), edgeBad(pr.Edges->Blocks(), 0);
+  // Each block's flags in a local, stored once: neighbouring flags share a cache line.
+  ForNodeBlocks(pr, parallel, [&](std::int64_t b, std::int64_t p0, std::int64_t p1) {
+    bool cost = false, hard = false;
+    for (std::int64_t i = p0 * pr.Labels; i < p1 * pr.Labels; ++i)
     {
-      return "a label cost is not finite; check the image for NaN or infinite values.";
+      cost = cost || !(std::fabs(pr.Cost[i]) <= 1e150);
     }
-  }
-  for (double w : pr.Weight)
-  {
-    if (!(w >= 0.0 && w <= 1e150))
+    for (std::int64_t p = p0; p < p1 && !pr.Hard.empty(); ++p)
     {
-      return "a boundary weight is negative or not finite.";
+      hard = hard || pr.Hard[p] < -1 || pr.Hard[p] >= pr.Labels;
     }
-  }
-  for (std::int16_t h : pr.Hard)
-  {
-    if (h < -1 || h >= pr.Labels)
-    {
-      return "a hard label lies outside [0, labels).";
-    }
-  }
-  bool bad = false;
-  pr.Edges->ForEach([&](std::int64_t, std::int64_t a, std::int64_t b) {
-    bad = bad || a < 0 || b < 0 || a >= pr.Nodes || b >= pr.Nodes;
+    nodeBad[b] = (cost ? BadCost : 0) | (hard ? BadHard : 0);
   });
-  return bad ? "an edge names a node outside the graph." : std::string();
+  ForBlocks(parallel, pr.Edges->Blocks(), [&](std::int64_t b) {
+    bool weight = false, end = false;
+    pr.Edges->ForEach(b, b + 1, [&](std::int64_t e, std::int64_t a, std::int64_t c) {
+      weight = weight || !(pr.Weight[e] >= 0.0 && pr.Weight[e] <= 1e150);
+      end = end || a < 0 || c < 0 || a >= pr.Nodes || c >= pr.Nodes;
+    });
+    edgeBad[b] = (weight ? BadWeight : 0) | (end ? BadEnd : 0);
+  });
+  std::uint8_t bad = 0;
+  for (std::uint8_t f : nodeBad)
+  {
+    bad |= f;
+  }
+  for (std::uint8_t f : edgeBad)
+  {
+    bad |= f;
+  }
+  return bad & BadCost ? "a label cost is not finite; check the image for NaN or infinite values."
+    : bad & BadWeight  ? "a boundary weight is negative or not finite."
+    : bad & BadHard    ? "a hard label lies outside [0, labels)."
+    : bad & BadEnd     ? "an edge names a node outside the graph."
+                       : std::string();
 }
 } // namespace
 
-double PottsEnergy(const PottsProblem& pr, const std::vector<std::uint8_t>& label)
+double PottsEnergy(const PottsProblem& pr, const std::vector<std::uint8_t>& label, const ParallelFor& parallel)
 {
-  double e = 0.0;
-  for (std::int64_t p = 0; p < pr.Nodes; ++p)
-  {
-    e += pr.Cost[p * pr.Labels + label[p]];
-  }
-  pr.Edges->ForEach([&](std::int64_t k, std::int64_t a, std::int64_t b) {
-    if (label[a] != label[b])
+  std::vector<double> nodeSum(NodeBlocks(pr), 0.0), edgeSum(pr.Edges->Blocks(), 0.0);
+  ForNodeBlocks(pr, parallel, [&](std::int64_t b, std::int64_t p0, std::int64_t p1) {
+    double sum = 0.0;
+    for (std::int64_t p = p0; p < p1; ++p)
     {
-      e += pr.Weight[k];
+      sum += pr.Cost[p * pr.Labels + label[p]];
     }
+    nodeSum[b] = sum;
   });
+  ForBlocks(parallel, pr.Edges->Blocks(), [&](std::int64_t b) {
+    double sum = 0.0;
+    pr.Edges->ForEach(b, b + 1, [&](std::int64_t k, std::int64_t a, std::int64_t c) {
+      sum += label[a] != label[c] ? pr.Weight[k] : 0.0;
+    });
+    edgeSum[b] = sum;
+  });
+  double e = 0.0;
+  for (double s : nodeSum)
+  {
+    e += s;
+  }
+  for (double s : edgeSum)
+  {
+    e += s;
+  }
   return e;
 }
 
@@ -118,13 +170,22 @@ void StartLabels(const PottsProblem& pr, std::vector<std::uint8_t>& label)
 }
 
 // A bound on the energy of any labelling: finite costs and weights whose sum overflows are an error.
-double EnergyBound(const PottsProblem& pr)
+double EnergyBound(const PottsProblem& pr, const ParallelFor& parallel)
 {
+  std::vector<double> sum(NodeBlocks(pr), 0.0);
+  ForNodeBlocks(pr, parallel, [&](std::int64_t b, std::int64_t p0, std::int64_t p1) {
+    double s = 0.0;
+    for (std::int64_t p = p0; p < p1; ++p)
+    {
+      const double* c = &pr.Cost[p * pr.Labels];
+      s += std::fabs(*std::max_element(c, c + pr.Labels)) + std::fabs(*std::min_element(c, c + pr.Labels));
+    }
+    sum[b] = s;
+  });
   double K = 1.0;
-  for (std::int64_t p = 0; p < pr.Nodes; ++p)
+  for (double s : sum)
   {
-    const double* c = &pr.Cost[p * pr.Labels];
-    K += std::fabs(*std::max_element(c, c + pr.Labels)) + std::fabs(*std::min_element(c, c + pr.Labels));
+    K += s;
   }
   for (double w : pr.Weight)
   {
@@ -310,6 +371,10 @@ struct RecycledMoves::State
   std::vector<LabelGraph> Graph;
   std::vector<std::uint32_t> Stamp; // a node's last visit, to visit each once per move
   std::uint32_t Visit = 0;
+  // Scratch of a sync: which of a node's costs changed, whether its label did; a move's terms.
+  std::vector<std::uint64_t> Which;
+  std::vector<std::uint8_t> Moved;
+  std::vector<double> Terms;
 };
 
 RecycledMoves::RecycledMoves() = default;
@@ -345,7 +410,8 @@ void RecordRelabelled(RecycledMoves::State& st, const std::vector<std::int64_t>&
 // The kept state for this problem and the labels the moves start from (null when its graphs would
 // not fit the budget): started afresh for another graph, weights or label count, else told which
 // nodes' labels, costs or hard labels changed.
-RecycledMoves::State* SyncRecycled(RecycledMoves& recycled, const PottsProblem& pr, const std::vector<std::uint8_t>& label)
+RecycledMoves::State* SyncRecycled(
+  RecycledMoves& recycled, const PottsProblem& pr, const std::vector<std::uint8_t>& label, const ParallelFor& parallel)
 {
   const std::int64_t n = pr.Nodes, m = pr.Edges->Size();
   const int L = pr.Labels;
@@ -370,31 +436,47 @@ RecycledMoves::State* SyncRecycled(RecycledMoves& recycled, const PottsProblem& 
     k->Stamp.assign(n, 0);
     return k.get();
   }
-  // Nodes whose label or hard label changed, and which of each node's label costs did (bit l for
+  // Per node, whether its label or hard label changed, and which of its label costs did (bit l for
   // label l, bit 63 for every label from 63 on).
-  std::vector<std::int64_t> relabelled, costChanged;
-  std::vector<std::uint64_t> which;
   const auto bit = [](int l) { return std::uint64_t(1) << std::min(l, 63); };
-  for (std::int64_t p = 0; p < n; ++p)
-  {
-    const std::int16_t h = HardLabel(pr, p);
-    const double* c = &pr.Cost[p * L];
-    double* was = &k->Cost[p * L];
-    if (h != k->Hard[p] || label[p] != k->Label[p])
+  std::vector<std::uint64_t>& which = k->Which;
+  std::vector<std::uint8_t>& moved = k->Moved;
+  which.resize(n);
+  moved.resize(n);
+  ForNodeBlocks(pr, parallel, [&](std::int64_t, std::int64_t p0, std::int64_t p1) {
+    for (std::int64_t p = p0; p < p1; ++p)
     {
-      relabelled.push_back(p);
-      k->Hard[p] = h;
-      k->Label[p] = label[p];
-    }
-    if (!std::equal(c, c + L, was))
-    {
-      costChanged.push_back(p);
-      which.push_back(0);
+      const std::int16_t h = HardLabel(pr, p);
+      const double* c = &pr.Cost[p * L];
+      double* was = &k->Cost[p * L];
+      std::uint64_t w = 0;
+      moved[p] = h != k->Hard[p] || label[p] != k->Label[p];
+      if (moved[p])
+      {
+        k->Hard[p] = h;
+        k->Label[p] = label[p];
+      }
       for (int l = 0; l < L; ++l)
       {
-        which.back() |= c[l] != was[l] ? bit(l) : 0;
+        if (c[l] != was[l])
+        {
+          w |= bit(l);
+          was[l] = c[l];
+        }
       }
-      std::copy(c, c + L, was);
+      which[p] = w;
+    }
+  });
+  std::vector<std::int64_t> relabelled, costChanged;
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    if (moved[p])
+    {
+      relabelled.push_back(p);
+    }
+    if (which[p])
+    {
+      costChanged.push_back(p);
     }
   }
   RecordRelabelled(*k, relabelled);
@@ -403,9 +485,10 @@ RecycledMoves::State* SyncRecycled(RecycledMoves& recycled, const PottsProblem& 
     LabelGraph& g = k->Graph[alpha];
     for (std::size_t i = 0; i < costChanged.size() && g.Built; ++i)
     {
-      if (which[i] & (bit(alpha) | bit(g.Label[costChanged[i]])))
+      const std::int64_t p = costChanged[i];
+      if (which[p] & (bit(alpha) | bit(g.Label[p])))
       {
-        g.CostChanged.push_back(costChanged[i]);
+        g.CostChanged.push_back(p);
       }
     }
     g.Built = g.Built && static_cast<std::int64_t>(g.Relabelled.size() + g.CostChanged.size()) <= 2 * n;
@@ -419,7 +502,7 @@ RecycledMoves::State* SyncRecycled(RecycledMoves& recycled, const PottsProblem& 
 // its new capacity sends the excess back through the terminals (Kohli & Torr's reparameterisation).
 // The same move as ExpansionMove, with every node in the graph: fixed ones stay isolated.
 double RecycledMove(const PottsProblem& pr, int alpha, const std::vector<std::uint8_t>& label, RecycledMoves::State& st,
-  std::vector<std::int64_t>& switched)
+  std::vector<std::int64_t>& switched, const ParallelFor& parallel)
 {
   const std::int64_t n = pr.Nodes, m = pr.Edges->Size();
   const int L = pr.Labels;
@@ -448,6 +531,19 @@ double RecycledMove(const PottsProblem& pr, int alpha, const std::vector<std::ui
       }
     }
     return take - keep;
+  };
+  // The terms of the nodes `list` names (all nodes when null), side by side: each reads only.
+  std::vector<double>& terms = st.Terms;
+  const auto netOf = [&](const std::vector<std::int64_t>* list, std::int64_t count) {
+    terms.resize(count);
+    const auto body = [&](std::int64_t i0, std::int64_t i1) {
+      for (std::int64_t i = i0; i < i1; ++i)
+      {
+        terms[i] = net(list ? (*list)[i] : i);
+      }
+    };
+    // A few nodes (most moves of a re-cut) are not worth starting threads for.
+    count < 16384 ? body(0, count) : parallel(count, 16384, body);
   };
   const auto capacities = [&](std::int64_t p, std::int64_t q, double w, double& c1, double& c2) {
     c1 = fixed(p) || fixed(q) ? 0.0 : w;
@@ -478,14 +574,14 @@ double RecycledMove(const PottsProblem& pr, int alpha, const std::vector<std::ui
     {
       AssignFresh(lg.Cap, static_cast<std::size_t>(2 * m));
     }
-    lg.Net.resize(n);
     pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
       capacities(p, q, pr.Weight[k], lg.Cap[2 * k], lg.Cap[2 * k + 1]);
       g.add_edge(static_cast<int>(p), static_cast<int>(q), lg.Cap[2 * k], lg.Cap[2 * k + 1]);
     });
+    netOf(nullptr, n);
+    lg.Net.swap(terms);
     for (std::int64_t p = 0; p < n; ++p)
     {
-      lg.Net[p] = net(p);
       g.add_tweights(static_cast<int>(p), std::max(lg.Net[p], 0.0), std::max(-lg.Net[p], 0.0));
     }
     lg.Label = label;
@@ -576,9 +672,11 @@ double RecycledMove(const PottsProblem& pr, int alpha, const std::vector<std::ui
     {
       touch(p);
     }
-    for (const std::int64_t p : touched)
+    netOf(&touched, static_cast<std::int64_t>(touched.size()));
+    for (std::size_t i = 0; i < touched.size(); ++i)
     {
-      const double t = net(p);
+      const std::int64_t p = touched[i];
+      const double t = terms[i];
       if (t != lg.Net[p])
       {
         addTerminal(p, t - lg.Net[p], 0.0);
@@ -610,10 +708,10 @@ double RecycledMove(const PottsProblem& pr, int alpha, const std::vector<std::ui
 } // namespace
 
 ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t> label, const ProgressFunction& progress,
-  int maxCycles, RecycledMoves* recycled)
+  int maxCycles, RecycledMoves* recycled, const ParallelFor& parallel)
 {
   ExpansionResult r;
-  r.Error = Validate(pr);
+  r.Error = Validate(pr, parallel);
   if (!r.Error.empty())
   {
     return r;
@@ -621,16 +719,16 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
   const std::int64_t n = pr.Nodes;
   const int L = pr.Labels;
   StartLabels(pr, label);
-  if (!std::isfinite(EnergyBound(pr)))
+  if (!std::isfinite(EnergyBound(pr, parallel)))
   {
     r.Error = "the energy overflows (lambda or the graph are too large); lower lambda.";
     return r;
   }
   const std::int64_t m = pr.Edges->Size();
-  double energy = PottsEnergy(pr, label);
+  double energy = PottsEnergy(pr, label, parallel);
   try
   {
-    RecycledMoves::State* kept = recycled ? SyncRecycled(*recycled, pr, label) : nullptr;
+    RecycledMoves::State* kept = recycled ? SyncRecycled(*recycled, pr, label, parallel) : nullptr;
     std::unique_ptr<Neighbourhood> own(kept ? nullptr : new Neighbourhood(pr));
     const Neighbourhood& around = kept ? *kept->Around : *own;
     std::unique_ptr<Flow> g(kept ? nullptr : new Flow(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory));
@@ -649,7 +747,7 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
           r.Aborted = true;
           return r;
         }
-        const double change = kept ? RecycledMove(pr, alpha, label, *kept, switched)
+        const double change = kept ? RecycledMove(pr, alpha, label, *kept, switched, parallel)
                                    : ExpansionMove(pr, alpha, label, around, *g, buffers, switched);
         if (!switched.empty() && change < -1e-9 * std::max(1.0, std::fabs(energy)))
         {
@@ -681,7 +779,7 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
     r.Error = "not enough memory for the max-flow graph (" + std::to_string(n) + " nodes, " + std::to_string(m) + " edges).";
     return r;
   }
-  r.Energy = PottsEnergy(pr, label); // summed afresh: the moves' changes carry rounding
+  r.Energy = PottsEnergy(pr, label, parallel); // summed afresh: the moves' changes carry rounding
   r.Label = std::move(label);
   return r;
 }

@@ -56,14 +56,19 @@ public:
   std::unique_ptr<State> Kept;
 };
 
-// The energy of `label` (hard constraints not checked).
-double PottsEnergy(const PottsProblem& problem, const std::vector<std::uint8_t>& label);
+// The energy of `label` (hard constraints not checked), summed over fixed blocks: the same for any
+// thread count.
+double PottsEnergy(const PottsProblem& problem, const std::vector<std::uint8_t>& label,
+  const ParallelFor& parallel = SerialFor());
 
 // From `start` (empty: each node's hard label, else its cheapest), at most `maxCycles` cycles.
 // Every input is checked first (finite costs and weights, edges naming nodes, hard labels in
 // range): a problem is an Error sentence. Progress after each move; an abort leaves Aborted.
 // With `recycled`, each label's move graph is kept and updated (above) instead of built anew; each
-// move is the same exact optimum, so the result differs only where a move has tied cuts.
+// move is the same exact optimum, so the result differs only where a move has tied cuts. `parallel`
+// runs the checks, the energy's sums (over fixed blocks) and a kept graph's terminal terms; the
+// result is the same for any thread count.
 ExpansionResult AlphaExpansion(const PottsProblem& problem, std::vector<std::uint8_t> start,
-  const ProgressFunction& progress = NoProgress(), int maxCycles = 8, RecycledMoves* recycled = nullptr);
+  const ProgressFunction& progress = NoProgress(), int maxCycles = 8, RecycledMoves* recycled = nullptr,
+  const ParallelFor& parallel = SerialFor());
 } // namespace featuremesh

@@ -279,6 +279,57 @@ std::string CheckSeeds(const LabelledSeeds& seeds)
   return ValidateSeedLabels(labels);
 }
 
+// Each node's region cost of every label (nodes x labels): lambda times the sum over its voxels'
+// runs of their bins' costs. A label whose bin costs are those of the kept cut's keeps its column
+// (a seed edit changes the densities of the edited labels only).
+std::vector<double> RegionCosts(const NodeBinRuns& runs, const std::vector<std::vector<double>>& costs, double lambda,
+  std::int64_t n, const ParallelFor& parallel, MultiLabelCache* cache)
+{
+  const int L = static_cast<int>(costs.size());
+  std::vector<double> own;
+  const bool keep = cache && cache->RegionLambda == lambda && cache->BinCosts.size() == costs.size() &&
+    static_cast<std::int64_t>(cache->Region.size()) == n * L;
+  std::vector<int> redo;
+  for (int l = 0; l < L; ++l)
+  {
+    if (!keep || cache->BinCosts[l] != costs[l])
+    {
+      redo.push_back(l);
+    }
+  }
+  std::vector<double>& region = cache ? cache->Region : own;
+  if (!keep)
+  {
+    region.assign(n * L, 0.0);
+  }
+  if (!redo.empty())
+  {
+    parallel(n, 16384, [&](std::int64_t b, std::int64_t e) {
+      for (std::int64_t p = b; p < e; ++p)
+      {
+        for (int l : redo)
+        {
+          region[p * L + l] = 0.0;
+        }
+        for (std::int64_t k = runs.Offset[p]; k < runs.Offset[p + 1]; ++k)
+        {
+          for (int l : redo)
+          {
+            region[p * L + l] += lambda * runs.Count[k] * costs[l][runs.Bin[k]];
+          }
+        }
+      }
+    });
+  }
+  if (!cache)
+  {
+    return own;
+  }
+  cache->BinCosts = costs;
+  cache->RegionLambda = lambda;
+  return region;
+}
+
 // The checks both cuts make first: the seeds' labels, the inputs' sizes, the parameters.
 std::string CheckInputs(const LabelledSeeds& seeds, bool sizesMatch, const char* mismatch, const SeededCutParameters& par)
 {
@@ -336,7 +387,7 @@ void SolveLabels(PottsProblem& pr, std::vector<std::int16_t> hard, const std::ve
   r.SetupSeconds = Since(t0);
   const auto t1 = Clock::now();
   ExpansionResult x = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.2, 0.95), multi.MaxCycles,
-    cache ? &cache->Moves : nullptr);
+    cache ? &cache->Moves : nullptr, parallel);
   r.ExpansionSeconds = Since(t1);
   if (!x.Error.empty() || x.Aborted)
   {
@@ -823,19 +874,7 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
   const std::shared_ptr<const FaceAdjacency> faces = mesh.SharedFaces();
   const GraphEdges edges(faces->A, faces->B, faces);
   pr.Edges = &edges;
-  pr.Cost.assign(n * L, 0.0);
-  parallel(n, 16384, [&](std::int64_t b, std::int64_t e) {
-    for (std::int64_t p = b; p < e; ++p)
-    {
-      for (std::int64_t k = runs.Offset[p]; k < runs.Offset[p + 1]; ++k)
-      {
-        for (int l = 0; l < L; ++l)
-        {
-          pr.Cost[p * L + l] += par.Lambda * runs.Count[k] * costs[l][runs.Bin[k]];
-        }
-      }
-    }
-  });
+  pr.Cost = RegionCosts(runs, costs, par.Lambda, n, parallel, cache);
   const SharedArray<double> step = MeshCentreSteps(mesh, data);
   std::vector<std::uint8_t> border(n, 0);
   for (std::int64_t e : faces->HullElement)

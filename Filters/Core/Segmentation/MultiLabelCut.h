@@ -134,9 +134,15 @@ struct MultiLabelCache
   std::vector<double> Weight;
   double WeightSigma = -1.0, Sigma = 0.0;
   bool WeightContact = false;
+  // Each label's bin costs and the nodes' region costs made from them, at RegionLambda.
+  std::vector<std::vector<double>> BinCosts;
+  std::vector<double> Region;
+  double RegionLambda = 0.0;
   void Clear()
   {
     this->Label.clear();
+    this->BinCosts.clear();
+    this->Region.clear();
     this->Geodesic.Clear();
     this->Term = GeodesicTerm();
     this->Moves.Clear();
