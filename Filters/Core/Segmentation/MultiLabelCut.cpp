@@ -716,7 +716,8 @@ std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>
   // edges between them.
   const std::int64_t n = static_cast<std::int64_t>(label.size());
   std::int64_t count = 0;
-  const std::vector<std::int64_t> comp = LabelComponents(label, edges, count);
+  std::vector<std::int64_t> edge; // (p, q, e) of the edges between labels
+  const std::vector<std::int64_t> comp = LabelComponents(label, edges, count, NoProgress(), &edge);
   std::vector<std::int64_t> root(count), size(count, 0);
   std::iota(root.begin(), root.end(), std::int64_t(0));
   std::vector<std::uint8_t> group(count, 0), seeded(count, 0), touches(count, 0);
@@ -732,13 +733,13 @@ std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>
     std::int64_t A, B;
     double W;
   };
-  std::vector<Between> between;
-  edges.ForEach([&](std::int64_t e, std::int64_t a, std::int64_t b) {
-    if (comp[a] != comp[b])
-    {
-      between.push_back({ comp[a], comp[b], weight.empty() ? 1.0 : weight[e] + 1e-300 });
-    }
-  });
+  // Nodes of different labels lie in different components, and an edge between equal labels joins.
+  std::vector<Between> between(edge.size() / 3);
+  for (std::size_t i = 0; i < between.size(); ++i)
+  {
+    const std::int64_t e = edge[3 * i + 2];
+    between[i] = { comp[edge[3 * i]], comp[edge[3 * i + 1]], weight.empty() ? 1.0 : weight[e] + 1e-300 };
+  }
   const auto find = [&](std::int64_t c) {
     while (root[c] != c)
     {

@@ -31,7 +31,7 @@ bool Components(const std::vector<std::uint8_t>& label, const GraphEdges& edges,
   std::vector<Index> parent;
   AssignFresh(parent, static_cast<std::size_t>(n));
   std::iota(parent.begin(), parent.end(), Index(0));
-  const auto unite = [&](std::int64_t, std::int64_t p64, std::int64_t q64) {
+  const auto unite = [&](std::int64_t e, std::int64_t p64, std::int64_t q64) {
     const Index p = static_cast<Index>(p64), q = static_cast<Index>(q64);
     if (label[p] == label[q])
     {
@@ -48,8 +48,7 @@ bool Components(const std::vector<std::uint8_t>& label, const GraphEdges& edges,
     }
     else if (between)
     {
-      between->push_back(p64);
-      between->push_back(q64);
+      between->insert(between->end(), { p64, q64, e });
     }
   };
   if (!edges.ForEachUntil(unite, [&](double t) { return progress(0.9 * t); }))
@@ -118,10 +117,10 @@ std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& lab
     }
   }
   // Components meeting across an edge: always of different labels.
-  std::vector<std::pair<std::int64_t, std::int64_t>> meet(between.size() / 2);
+  std::vector<std::pair<std::int64_t, std::int64_t>> meet(between.size() / 3);
   for (std::size_t e = 0; e < meet.size(); ++e)
   {
-    const std::int64_t a = id[between[2 * e]], b = id[between[2 * e + 1]];
+    const std::int64_t a = id[between[3 * e]], b = id[between[3 * e + 1]];
     meet[e] = { std::min(a, b), std::max(a, b) };
   }
   std::sort(meet.begin(), meet.end());

@@ -43,7 +43,7 @@ inline Connectivity ConnectivityFor(Connectivity mode, Task task)
 // Components of equal label over the graph's edges: an id per node, numbered in order of each
 // component's first node (deterministic); `count` receives their number. Empty when `progress`
 // (asked every 2^18 edges: a voxel graph has tens of millions) aborts. `between` (optional)
-// receives the edges between different labels as node pairs (p, q, p, q, ...), in edge order.
+// receives the edges between different labels as (p, q, e) triples, in edge order.
 std::vector<std::int64_t> LabelComponents(const std::vector<std::uint8_t>& label, const GraphEdges& edges,
   std::int64_t& count, const ProgressFunction& progress = NoProgress(), std::vector<std::int64_t>* between = nullptr);
 
