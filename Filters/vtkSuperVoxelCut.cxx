@@ -1,7 +1,7 @@
 #include "vtkSuperVoxelCut.h"
-#include "Memory.h"
 
 #include "Contract.h"
+#include "Memory.h"
 #include "MultiLabelCut.h"
 #include "SuperVoxelCut.h"
 #include "vtkFeatureMeshUtilities.h"
