@@ -29,15 +29,19 @@ std::int64_t NodeBlocks(const PottsProblem& pr)
   return (pr.Nodes + NodeBlock - 1) / NodeBlock;
 }
 
+// Threads start per loop (VTK 9.2's STDThread backend): a graph of a few blocks runs on this one.
+constexpr std::int64_t ThreadedBlocks = 8;
+
 template <typename F>
 void ForBlocks(const ParallelFor& parallel, std::int64_t blocks, F&& f)
 {
-  parallel(blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+  const auto body = [&](std::int64_t b0, std::int64_t b1) {
     for (std::int64_t b = b0; b < b1; ++b)
     {
       f(b);
     }
-  });
+  };
+  blocks < ThreadedBlocks ? body(0, blocks) : parallel(blocks, 1, body);
 }
 
 template <typename F>
@@ -543,7 +547,7 @@ double RecycledMove(const PottsProblem& pr, int alpha, const std::vector<std::ui
       }
     };
     // A few nodes (most moves of a re-cut) are not worth starting threads for.
-    count < 16384 ? body(0, count) : parallel(count, 16384, body);
+    count < ThreadedBlocks * NodeBlock ? body(0, count) : parallel(count, NodeBlock, body);
   };
   const auto capacities = [&](std::int64_t p, std::int64_t q, double w, double& c1, double& c2) {
     c1 = fixed(p) || fixed(q) ? 0.0 : w;
