@@ -59,4 +59,22 @@ for r in rows:
     for mesh in ("canny", "rsp"):
         ft.check(0 < v["dice_" + mesh] <= v["oracle_" + mesh] + 1e-9 <= 1.0 + 1e-9,
                  "%s: %s mesh: Dice %.3f <= oracle %.3f" % (r["case"], mesh, v["dice_" + mesh], v["oracle_" + mesh]))
+
+# The kept re-cut's benchmark: the bundled object case and the bundled labelled case, each edit's
+# cut timed with its parts inside it.
+script = os.path.join(ft.fm.ROOT, "scripts", "benchmark_recut.py")
+run = subprocess.run([shutil.which("pvpython"), script, "--edits", "2", "--out", out + "_recut"], env=env,
+                     capture_output=True, text=True)
+print(run.stdout[-1500:])
+ft.check(run.returncode == 0, "benchmark_recut.py exits 0 (stderr: %s)" % run.stderr[-500:])
+rows = list(csv.DictReader(open(out + "_recut.csv"))) if os.path.isfile(out + "_recut.csv") else []
+ft.check(sorted({(r["case"], r["labels"]) for r in rows}) == [("abdomen-ct-totalseg", "6"), ("liver-ct-totalseg", "2")],
+         "benchmark_recut: the liver (2 labels) and the abdomen (6)")
+for case in ("liver-ct-totalseg", "abdomen-ct-totalseg"):
+    for edit in ("add", "remove"):
+        part = {r["part"]: float(r["median_s"]) for r in rows if r["case"] == case and r["edit"] == edit}
+        solve = "FlowSeconds" if case.startswith("liver") else "ExpansionSeconds"
+        ft.check(part.get("CutTotalSeconds", 0) > 0 and all(part.get(p, -1) >= 0 for p in ("SetupSeconds", "GeodesicSeconds", solve)) and
+                 part["SetupSeconds"] + part[solve] <= part["CutTotalSeconds"] + 1e-9,
+                 "%s, %s a seed: the cut %.3f s holds its parts" % (case, edit, part.get("CutTotalSeconds", 0)))
 ft.finish("benchmark")
