@@ -15,6 +15,7 @@ import argparse
 import csv
 import os
 import statistics
+import tempfile
 
 import numpy as np
 import paraview.simple as ps
@@ -24,6 +25,11 @@ from featuremesh import report
 from benchmark_multilabel import field, robot_seed, write_seeds
 
 PARTS = ("CutTotalSeconds", "SetupSeconds", "GeodesicSeconds", "FlowSeconds", "ExpansionSeconds")
+
+
+def delete_all():
+    for p in ps.GetSources().values():
+        ps.Delete(p)
 
 
 def world(image, k, j, i):
@@ -64,7 +70,11 @@ def binary_case(name, folder, args):
     cut = ps.SuperVoxelCut(Mesh=mesh, ObjectSeeds=object_source, BackgroundSeeds=background_source, Image=case.image,
                            Scalars=case.scalars, **case.with_task({}))
     cut.UpdatePipeline()
-    k, j, i, label = robot_seed(fm.labels(cut), truth, shape, spacing)
+    found = robot_seed(fm.labels(cut), truth, shape, spacing)
+    if found is None:
+        delete_all()
+        return None  # the cut is right: no seed to add
+    k, j, i, label = found
     kind = "object" if label else "background"
     source = object_source if label else background_source
     added = rows[kind] + [world(image, k, j, i)]
@@ -74,8 +84,7 @@ def binary_case(name, folder, args):
 
     times = edits(cut, apply, args)
     elements = fm.fetch(cut, 0).GetNumberOfCells()
-    for p in ps.GetSources().values():
-        ps.Delete(p)
+    delete_all()
     return {"case": name, "labels": 2, "elements": elements, "seed": kind, "times": times}
 
 
@@ -89,7 +98,11 @@ def multilabel_case(name, folder, args, tmp):
     mesh = case.mesh()
     cut = case.super_voxel_cut(mesh)
     cut.UpdatePipeline()
-    k, j, i, label = robot_seed(fm.labels(cut), truth, shape, spacing)
+    found = robot_seed(fm.labels(cut), truth, shape, spacing)
+    if found is None:
+        delete_all()
+        return None
+    k, j, i, label = found
     readers = {}
     for edit, seeds in (("add", rows + [tuple(world(image, k, j, i)) + (label,)]), ("remove", rows)):
         path = os.path.join(tmp, "%s-%s.csv" % (name, edit))
@@ -102,14 +115,11 @@ def multilabel_case(name, folder, args, tmp):
 
     times = edits(cut, apply, args)
     elements = fm.fetch(cut, 0).GetNumberOfCells()
-    for p in ps.GetSources().values():
-        ps.Delete(p)
+    delete_all()
     return {"case": name, "labels": len(case.names), "elements": elements, "seed": case.names[label], "times": times}
 
 
 def main():
-    import tempfile
-
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--edits", type=int, default=10)
     ap.add_argument("--cases", default="")
@@ -124,10 +134,11 @@ def main():
         for name, folder in binary.items():
             if os.path.exists(os.path.join(folder, "truth.mha")):
                 results.append(binary_case(name, folder, args))
-                print(name, flush=True)
+                print(name, "no seed to add" if results[-1] is None else "", flush=True)
         for name, folder in labelled.items():
             results.append(multilabel_case(name, folder, args, tmp))
-            print(name, flush=True)
+            print(name, "no seed to add" if results[-1] is None else "", flush=True)
+    results = [r for r in results if r is not None]
     lines = ["# The kept re-cut", "", report.machine(), "",
              "The robot's first seed added and removed %d times each, the label image held; seconds of the cut "
              "(median, smallest in brackets) and the medians of its parts." % args.edits, "",

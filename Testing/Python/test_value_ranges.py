@@ -87,8 +87,8 @@ ft.check(cached(labels, vtkAbstractArray.PER_COMPONENT()) is None and labels.Get
 # one's image.
 
 
-def on_voxels(cut, voxels):
-    """Whether a cut's label image holds each voxel's element label (0 outside the mesh)."""
+def on_voxels(cut, voxels, mesh):
+    """Whether a cut's label image holds each voxel's element label (0 outside `mesh`)."""
     owner = ft.fm.v2n(ft.fm.owner_map(mesh))
     cells = ft.fm.v2n(cut.GetClientSideObject().GetOutputDataObject(0).GetCellData().GetArray(ft.names.Label))
     return ft.np.array_equal(ft.fm.v2n(voxels), ft.np.where(owner >= 0, cells[ft.np.maximum(owner, 0)], 0))
@@ -114,7 +114,7 @@ if os.path.isdir(abdomen):
         shown = multi.GetDataInformation(2).GetPointDataInformation().GetArrayInformation(ft.names.Label).GetComponentRange(0)
         ft.check(tuple(shown) == (0.0, float(k)) and computed(voxels)[0] == [(0.0, float(k))],
                  "abdomen, labels 0..%d: ParaView shows the label image's range %s" % (k, tuple(shown)))
-        ft.check(on_voxels(multi, voxels), "abdomen, labels 0..%d: the label image is the elements' labels on their voxels" % k)
+        ft.check(on_voxels(multi, voxels, mesh), "abdomen, labels 0..%d: the label image is the elements' labels on their voxels" % k)
     # A new cut's first re-cut, its image held (as a view holds it): a copy of it patched where the
     # first seed, moved by a voxel, changed labels.
     edited = rows[rows[:, 3] <= 2].copy()
@@ -128,5 +128,5 @@ if os.path.isdir(abdomen):
             fresh.Seeds = ps.CSVReader(FileName=[path])
         fresh.UpdatePipeline()
         held = fresh.GetClientSideObject().GetOutputDataObject(2).GetPointData().GetArray(ft.names.Label)
-        ft.check(on_voxels(fresh, held), "abdomen, a seed moved (%d): the label image is the elements' labels" % step)
+        ft.check(on_voxels(fresh, held, mesh), "abdomen, a seed moved (%d): the label image is the elements' labels" % step)
 ft.finish("value range")
