@@ -164,6 +164,10 @@ std::vector<std::int32_t> VoxelOwners(const ElementRasterizer& raster, const Par
       });
     }
   });
-  return done ? owner : std::vector<std::int32_t>();
+  if (!done)
+  {
+    owner.clear();
+  }
+  return owner; // not a conditional expression, which would copy the map
 }
 } // namespace featuremesh

@@ -78,7 +78,11 @@ std::vector<std::int64_t> LabelComponents(const std::vector<std::uint8_t>& label
   const bool done = label.size() < (std::size_t(1) << 31)
     ? Components<std::int32_t>(label, edges, id, count, between, progress)
     : Components<std::int64_t>(label, edges, id, count, between, progress);
-  return done ? id : std::vector<std::int64_t>();
+  if (!done)
+  {
+    id.clear();
+  }
+  return id; // not a conditional expression, which would copy it
 }
 
 std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label, const GraphEdges& edges,
@@ -214,7 +218,11 @@ std::vector<double> ObjectComponentSizes(
 {
   std::vector<std::uint8_t> unchanged(label);
   std::vector<double> sizes;
-  return ApplyConnectivity(Connectivity::Off, unchanged, edges, {}, {}, progress, &sizes, size) < 0 ? std::vector<double>() : sizes;
+  if (ApplyConnectivity(Connectivity::Off, unchanged, edges, {}, {}, progress, &sizes, size) < 0)
+  {
+    sizes.clear();
+  }
+  return sizes;
 }
 
 } // namespace featuremesh
