@@ -81,6 +81,15 @@ public:
     }
   }
 
+  // Asks the cache for p's neighbours ahead of their use (Dijkstra, as it pushes p: the block is
+  // then in cache when p pops, instead of one miss per pop).
+  void Prefetch(std::int64_t p) const
+  {
+    if (this->Explicit && this->Offset.empty())
+    {
+      __builtin_prefetch(this->Storage.data() + this->First + Slots * p);
+    }
+  }
   // f(q, step) for every neighbour q of p.
   template <typename F>
   void ForEach(std::int64_t p, F&& f) const
@@ -286,6 +295,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
     adjacency.ForEach(p, [&](std::int64_t q, double step) {
       if (Relax(field, value, p, q, step, inverse, lengthWeight))
       {
+        adjacency.Prefetch(q); // in cache by the time q pops
         heap.Push(key(distance[q], q));
       }
     });
