@@ -932,8 +932,8 @@ struct NoisyGridGraph
 TEST(SeedGeodesics, KeptDistancesEqualFreshOnes)
 {
   // A noisy 40 x 30 grid as explicit edges with random steps; a chain of seed edits through one
-  // cache: seeds added, removed, moved, both kinds at once, nothing changed. Every cut's costs
-  // equal those computed afresh (up to the rounding of equal-length paths summed in another order).
+  // cache: seeds added, removed, moved, both kinds at once, nothing changed, a new weight. Every
+  // cut's costs (redone where the distances changed) equal those computed afresh (up to the rounding of equal-length paths summed in another order).
   const NoisyGridGraph grid(5);
   const ImageGeometry& g = grid.g;
   const GeodesicGraph& graph = grid.graph;
@@ -945,11 +945,22 @@ TEST(SeedGeodesics, KeptDistancesEqualFreshOnes)
     { g.Index(2, 1, 0), g.Index(30, 5, 0) }, { g.Index(39, 29, 0), g.Index(0, 29, 0) } };
   SeedGeodesicCache cache;
   SeedGeodesicParameters p;
+  // The costs of every other edit held on: the cache redoes its own copy, never what a holder has.
+  SharedArray<double> held;
+  std::vector<double> heldWas;
   for (std::size_t edit = 0; edit < object.size(); ++edit)
   {
+    // One edit at another weight: every cost is redone.
+    p.Weight = edit == 4 ? 0.75 : SeedGeodesicParameters().Weight;
     const std::vector<std::uint8_t> hard = grid.Hard(object[edit], background[edit]);
-    std::vector<double> keptObject, keptBackground, freshObject, freshBackground;
+    SharedArray<double> keptObject, keptBackground, freshObject, freshBackground;
     ASSERT_TRUE(SeedGeodesicCosts(graph, hard, 40.0, p, SerialFor(), keptObject, keptBackground, NoProgress(), &cache));
+    EXPECT_EQ(held.Vector(), heldWas) << "edit " << edit;
+    if (edit % 2 == 0)
+    {
+      held = keptObject;
+      heldWas = keptObject.Vector();
+    }
     ASSERT_TRUE(SeedGeodesicCosts(graph, hard, 40.0, p, SerialFor(), freshObject, freshBackground));
     ASSERT_EQ(keptObject.size(), freshObject.size());
     for (std::size_t v = 0; v < freshObject.size(); ++v)
@@ -1072,7 +1083,7 @@ TEST(SeedGeodesics, DistancesAddTheStepsAndTheLength)
   EXPECT_DOUBLE_EQ(d[1], 0.1);
   EXPECT_DOUBLE_EQ(d[2], 0.1 + 1.0 + 0.2);
   EXPECT_DOUBLE_EQ(d[3], 1.3 + 0.1);
-  std::vector<double> costObject, costBackground;
+  SharedArray<double> costObject, costBackground;
   SeedGeodesicParameters p;
   ASSERT_TRUE(SeedGeodesicCosts(graph, hard, 10.0, p, SerialFor(), costObject, costBackground));
   ASSERT_EQ(costObject.size(), 4u);

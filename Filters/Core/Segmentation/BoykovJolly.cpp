@@ -961,7 +961,7 @@ bool AddSeedGeodesicTerm(const CutProblem& pr, double range, SeedGeodesicCache* 
   graph.Edges = &pr.Edges;
   graph.Value = pr.Value;
   graph.Step = pr.Step;
-  std::vector<double> spatialObject, spatialBackground;
+  SharedArray<double> spatialObject, spatialBackground;
   if (!SeedGeodesicCosts(graph, pr.Hard, range, pr.Geodesic, pr.Parallel, spatialObject, spatialBackground, progress, kept))
   {
     return false;

@@ -195,6 +195,40 @@ struct DistanceField
   bool KeepsSums = false;
   std::vector<double> Intensity, Travel;
   double Scale = 0.0;               // the intensity unit the distances are in
+  // The nodes whose distance changed since Settle(), each once; or every node (AllChanged, also
+  // before the first Settle()). Lets the costs made of a kept field be redone where it changed.
+  std::vector<std::int64_t> Changed;
+  std::vector<std::uint8_t> Marked;
+  bool AllChanged = true;
+
+  void Change(std::int64_t p)
+  {
+    if (!this->AllChanged && !this->Marked[p])
+    {
+      this->Marked[p] = 1;
+      this->Changed.push_back(p);
+    }
+  }
+  void ChangeAll()
+  {
+    this->AllChanged = true;
+    std::vector<std::int64_t>().swap(this->Changed);
+    std::vector<std::uint8_t>().swap(this->Marked);
+  }
+  // What changed so far has been taken into account: record changes from here on.
+  void Settle()
+  {
+    if (this->AllChanged)
+    {
+      this->Marked.assign(this->Distance.size(), 0);
+    }
+    for (std::int64_t p : this->Changed)
+    {
+      this->Marked[p] = 0;
+    }
+    this->Changed.clear();
+    this->AllChanged = false;
+  }
 };
 
 // Relaxes the edge p -> q (of length `step`) in `field` at `inverse` = 1 / scale: true when it
@@ -239,6 +273,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   const double* value = g.Value.data();
   if (field.Distance.empty())
   {
+    field.ChangeAll();
     field.Distance.assign(n, std::numeric_limits<double>::infinity());
     field.Root.assign(n, -1);
     if (field.KeepsSums)
@@ -266,6 +301,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   {
     distance[p] = 0.0;
     field.Root[p] = static_cast<std::int32_t>(p);
+    field.Change(p);
     if (field.KeepsSums)
     {
       field.Intensity[p] = 0.0;
@@ -296,6 +332,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
       if (Relax(field, value, p, q, step, inverse, lengthWeight))
       {
         adjacency.Prefetch(q); // in cache by the time q pops
+        field.Change(q);
         heap.Push(key(distance[q], q));
       }
     });
@@ -318,6 +355,7 @@ bool Rescale(const GeodesicGraph& g, const Adjacency& adjacency, double scale, d
   }
   const double* value = g.Value.data();
   const double inverse = 1.0 / scale;
+  field.ChangeAll();
   std::vector<double>& distance = field.Distance;
   for (std::int64_t p = 0; p < n; ++p)
   {
@@ -380,6 +418,7 @@ bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::
       {
         field.Distance[p] = std::numeric_limits<double>::infinity();
         field.Root[p] = -1;
+        field.Change(p);
         orphans.push_back(p);
       }
     }
@@ -432,6 +471,9 @@ struct SeedGeodesicCache::Kept
   // Per seed kind (index kind - 1).
   std::vector<std::vector<std::int64_t>> Seeds;
   std::vector<DistanceField> Field;
+  // SeedGeodesicCosts' costs at CostWeight, of the first two fields as they were at their Settle().
+  SharedArray<double> CostObject, CostBackground;
+  double CostWeight = -1.0;
 
   bool SameGraph(const GeodesicGraph& g) const
   {
@@ -637,11 +679,11 @@ std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph& graph, c
 }
 
 bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard, double scale,
-  const SeedGeodesicParameters& par, const ParallelFor& parallel, std::vector<double>& costObject,
-  std::vector<double>& costBackground, const ProgressFunction& progress, SeedGeodesicCache* cache)
+  const SeedGeodesicParameters& par, const ParallelFor& parallel, SharedArray<double>& costObject,
+  SharedArray<double>& costBackground, const ProgressFunction& progress, SeedGeodesicCache* cache)
 {
-  costObject.clear();
-  costBackground.clear();
+  costObject = SharedArray<double>();
+  costBackground = SharedArray<double>();
   std::vector<std::vector<std::int64_t>> seeds{ SeedNodes(hard, 1), SeedNodes(hard, 2) };
   if (par.Weight <= 0.0 || seeds[0].empty() || seeds[1].empty() || graph.Nodes() == 0)
   {
@@ -653,25 +695,59 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
   {
     return false;
   }
-  const std::vector<double>& toObject = kept->Field[0].Distance;
-  const std::vector<double>& toBackground = kept->Field[1].Distance;
+  // Each node's costs from its two distances, redone where either changed.
+  DistanceField& fieldObject = kept->Field[0];
+  DistanceField& fieldBackground = kept->Field[1];
+  const std::vector<double>& toObject = fieldObject.Distance;
+  const std::vector<double>& toBackground = fieldBackground.Distance;
+  std::vector<double>& keptObject = kept->CostObject.Mutable();
+  std::vector<double>& keptBackground = kept->CostBackground.Mutable();
   constexpr double mix = 0.01;
-  costObject.resize(graph.Nodes());
-  costBackground.resize(graph.Nodes());
-  parallel(graph.Nodes(), 65536, [&](std::int64_t p0, std::int64_t p1) {
-    for (std::int64_t p = p0; p < p1; ++p)
+  const auto cost = [&](std::int64_t p) {
+    const double dO = toObject[p], dB = toBackground[p];
+    // Unreachable from both (a separate component): no preference.
+    double object = 0.5;
+    if (std::isfinite(dO) || std::isfinite(dB))
     {
-      const double dO = toObject[p], dB = toBackground[p];
-      // Unreachable from both (a separate component): no preference.
-      double object = 0.5;
-      if (std::isfinite(dO) || std::isfinite(dB))
-      {
-        object = !std::isfinite(dB) ? 1.0 : (!std::isfinite(dO) ? 0.0 : (dO + dB > 0.0 ? dB / (dO + dB) : 0.5));
-      }
-      costObject[p] = -par.Weight * std::log(mix + (1.0 - 2.0 * mix) * object);
-      costBackground[p] = -par.Weight * std::log(mix + (1.0 - 2.0 * mix) * (1.0 - object));
+      object = !std::isfinite(dB) ? 1.0 : (!std::isfinite(dO) ? 0.0 : (dO + dB > 0.0 ? dB / (dO + dB) : 0.5));
     }
-  });
+    keptObject[p] = -par.Weight * std::log(mix + (1.0 - 2.0 * mix) * object);
+    keptBackground[p] = -par.Weight * std::log(mix + (1.0 - 2.0 * mix) * (1.0 - object));
+  };
+  const std::int64_t n = graph.Nodes();
+  if (fieldObject.AllChanged || fieldBackground.AllChanged || kept->CostWeight != par.Weight ||
+    static_cast<std::int64_t>(keptObject.size()) != n)
+  {
+    keptObject.resize(n);
+    keptBackground.resize(n);
+    parallel(n, 65536, [&](std::int64_t p0, std::int64_t p1) {
+      for (std::int64_t p = p0; p < p1; ++p)
+      {
+        cost(p);
+      }
+    });
+  }
+  else
+  {
+    // Each list names a node once; the two lists run one after the other.
+    for (const std::vector<std::int64_t>* changed : { &fieldObject.Changed, &fieldBackground.Changed })
+    {
+      parallel(static_cast<std::int64_t>(changed->size()), 16384, [&](std::int64_t i0, std::int64_t i1) {
+        for (std::int64_t i = i0; i < i1; ++i)
+        {
+          cost((*changed)[i]);
+        }
+      });
+    }
+  }
+  kept->CostWeight = par.Weight;
+  if (cache)
+  {
+    fieldObject.Settle();
+    fieldBackground.Settle();
+  }
+  costObject = kept->CostObject;
+  costBackground = kept->CostBackground;
   if (cache)
   {
     cache->State = kept;

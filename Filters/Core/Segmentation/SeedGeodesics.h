@@ -66,7 +66,7 @@ private:
   friend std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph&, const std::vector<std::uint8_t>&, int,
     double, double, const ProgressFunction&, SeedGeodesicCache*, const ParallelFor&);
   friend bool SeedGeodesicCosts(const GeodesicGraph&, const std::vector<std::uint8_t>&, double, const SeedGeodesicParameters&,
-    const ParallelFor&, std::vector<double>&, std::vector<double>&, const ProgressFunction&, SeedGeodesicCache*);
+    const ParallelFor&, SharedArray<double>&, SharedArray<double>&, const ProgressFunction&, SeedGeodesicCache*);
   std::shared_ptr<Kept> State;
   // The kept distances when they were made on this graph, else a fresh record; the cache is empty
   // until the caller stores the record back whole.
@@ -76,10 +76,12 @@ private:
 // The spatial term per voxel of each node (costObject, costBackground), from the distances to the
 // object and the background seeds; the two runs share `parallel`'s threads (two at most; progress
 // is then reported between them only). False when progress asks to abort; true with empty costs
-// when Weight is 0 or either seed kind is absent. `cache` (optional) keeps what the next cut reuses.
+// when Weight is 0 or either seed kind is absent. `cache` (optional) keeps what the next cut reuses,
+// the costs among it: they are shared with the cache, which redoes them where the distances changed
+// unless a holder still has them.
 bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard, double scale,
-  const SeedGeodesicParameters& parameters, const ParallelFor& parallel, std::vector<double>& costObject,
-  std::vector<double>& costBackground, const ProgressFunction& progress = NoProgress(),
+  const SeedGeodesicParameters& parameters, const ParallelFor& parallel, SharedArray<double>& costObject,
+  SharedArray<double>& costBackground, const ProgressFunction& progress = NoProgress(),
   SeedGeodesicCache* cache = nullptr);
 
 // Distances of every node from the seeds of each kind 1..kinds (hard[p] == kind), kept in `cache`
