@@ -382,7 +382,7 @@ TEST(MultiLabel, LargeGraphsRunTheirKindsFromAHelperThread)
   const std::thread::id here = std::this_thread::get_id();
   std::vector<double> reported;
   bool elsewhere = false;
-  const std::vector<std::vector<double>> d = SeedKindDistances(graph, hard, 3, 97.0, 0.01, [&](double t) {
+  const auto d = SeedKindDistances(graph, hard, 3, 97.0, 0.01, [&](double t) {
     elsewhere = elsewhere || std::this_thread::get_id() != here;
     reported.push_back(t);
     return true;
@@ -391,7 +391,7 @@ TEST(MultiLabel, LargeGraphsRunTheirKindsFromAHelperThread)
   EXPECT_FALSE(elsewhere);
   EXPECT_TRUE(std::is_sorted(reported.begin(), reported.end()));
   for (int kind = 1; kind <= 3; ++kind)
-    EXPECT_EQ(d[kind - 1], GeodesicDistances(graph, hard, static_cast<std::uint8_t>(kind), 97.0, 0.01)) << "kind " << kind;
+    EXPECT_EQ(d[kind - 1].Vector(), GeodesicDistances(graph, hard, static_cast<std::uint8_t>(kind), 97.0, 0.01)) << "kind " << kind;
   const auto start = std::chrono::steady_clock::now();
   EXPECT_TRUE(SeedKindDistances(graph, hard, 3, 97.0, 0.01, [](double) { return false; }, nullptr, TwoThreads).empty());
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
@@ -765,7 +765,9 @@ TEST(MultiLabelSurface, AJunctionCurveMovesAlongItselfIn3D)
 TEST(MultiLabel, KeptDistancesOfEveryLabelEqualFreshOnes)
 {
   // Three seed kinds on a noisy grid, through one cache: seeds added, removed and moved, one kind at
-  // a time and together; every kind's distances equal those made afresh.
+  // a time and together; every kind's distances equal those made afresh, every node whose distance
+  // moved is listed once among its kind's changes, and the last edit's distances, held, stay as
+  // they were.
   const ImageGeometry g = Grid(40, 30);
   std::mt19937 rng(23);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -785,12 +787,33 @@ TEST(MultiLabel, KeptDistancesOfEveryLabelEqualFreshOnes)
     {}, { { g.Index(10, 10, 0), 1 } }, { { g.Index(3, 3, 0), 0 } }, { { g.Index(25, 25, 0), 3 }, { g.Index(20, 5, 0), 0 } },
     { { g.Index(30, 20, 0), 0 }, { g.Index(31, 20, 0), 2 } }, {}
   };
+  std::vector<SharedArray<double>> held;
+  std::vector<std::vector<double>> was;
   for (const auto& edit : edits)
   {
     for (const auto& e : edit)
       hard[e.first] = static_cast<std::uint8_t>(e.second);
-    const auto kept = SeedKindDistances(graph, hard, 3, 10.0, 0.01, NoProgress(), &cache);
+    SeedDistanceChanges changes;
+    const auto kept = SeedKindDistances(graph, hard, 3, 10.0, 0.01, NoProgress(), &cache, SerialFor(), &changes);
     ASSERT_EQ(kept.size(), 3u);
+    EXPECT_EQ(changes.All, held.empty());
+    for (int k = 0; k < 3 && !held.empty(); ++k)
+    {
+      EXPECT_EQ(held[k].Vector(), was[k]) << "kind " << k + 1;
+      std::vector<int> listed(g.Size(), 0);
+      for (std::int64_t p : changes.Nodes[k])
+        ++listed[p];
+      for (std::int64_t p = 0; p < g.Size(); ++p)
+      {
+        EXPECT_LE(listed[p], 1) << "kind " << k + 1 << " node " << p;
+        if (kept[k][p] != was[k][p])
+          ASSERT_EQ(listed[p], 1) << "kind " << k + 1 << " node " << p << " changed unlisted";
+      }
+    }
+    held = kept;
+    was.assign(kept.size(), {});
+    for (int k = 0; k < 3; ++k)
+      was[k] = kept[k].Vector();
     // The kinds on two threads: the same distances.
     EXPECT_EQ(SeedKindDistances(graph, hard, 3, 10.0, 0.01, NoProgress(), &threaded, TwoThreads), kept);
     for (int k = 0; k < 3; ++k)

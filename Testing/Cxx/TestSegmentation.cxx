@@ -996,7 +996,7 @@ TEST(SeedGeodesics, KeptDistancesAtANewScaleEqualFreshOnes)
   for (std::size_t edit = 0; edit < object.size(); ++edit)
   {
     const std::vector<std::uint8_t> hard = grid.Hard(object[edit], background[edit]);
-    const std::vector<std::vector<double>> kept = SeedKindDistances(graph, hard, 2, scales[edit], 0.01, NoProgress(), &cache);
+    const auto kept = SeedKindDistances(graph, hard, 2, scales[edit], 0.01, NoProgress(), &cache);
     ASSERT_EQ(kept.size(), 2u);
     for (int kind : { 1, 2 })
     {

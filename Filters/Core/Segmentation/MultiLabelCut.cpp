@@ -191,16 +191,17 @@ bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, 
   {
     kind[p] = static_cast<std::uint8_t>(hard[p] + 1);
   }
-  std::vector<std::vector<double>> distance =
-    SeedKindDistances(graph, kind, L, 1.0, geo.LengthWeight, progress, cache ? &cache->Geodesic : nullptr, parallel);
+  SeedDistanceChanges changes;
+  const std::vector<SharedArray<double>> distance = SeedKindDistances(
+    graph, kind, L, 1.0, geo.LengthWeight, progress, cache ? &cache->Geodesic : nullptr, parallel, &changes);
   if (distance.empty())
   {
     return false;
   }
   // A node's term is redone only when one of its distances changed since the kept cut's.
   GeodesicTerm* kept = cache ? &cache->Term : nullptr;
-  const bool reuse = kept && kept->Labels == L && kept->Weight == geo.Weight && kept->Lambda == lambda &&
-    kept->Size == size && kept->Distance.size() == distance.size();
+  const bool reuse = kept && !changes.All && kept->Labels == L && kept->Weight == geo.Weight &&
+    kept->Lambda == lambda && kept->Size == size && static_cast<std::int64_t>(kept->Term.size()) == n * L;
   if (kept && !reuse)
   {
     kept->Labels = L;
@@ -212,44 +213,52 @@ bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, 
   std::vector<double> own(kept ? 0 : n * L);
   std::vector<double>& term = kept ? kept->Term : own;
   const double mix = 0.01;
-  parallel(n, 16384, [&](std::int64_t p0, std::int64_t p1) {
-    for (std::int64_t p = p0; p < p1; ++p)
+  const auto redo = [&](std::int64_t p) {
+    double total = 0.0;
+    int zeros = 0;
+    for (int l = 0; l < L; ++l)
     {
-      bool same = reuse;
-      for (int l = 0; l < L && same; ++l)
+      const double d = distance[l][p];
+      zeros += d == 0.0;
+      total += d > 0.0 && std::isfinite(d) ? 1.0 / d : 0.0;
+    }
+    const double s = lambda * (size.empty() ? 1.0 : size[p]);
+    for (int l = 0; l < L; ++l)
+    {
+      const double d = distance[l][p];
+      const double share = zeros ? (d == 0.0 ? 1.0 / zeros : 0.0)
+                                 : (total > 0.0 ? (std::isfinite(d) ? 1.0 / d / total : 0.0) : 1.0 / L);
+      term[p * L + l] = s * -geo.Weight * std::log(mix + (1.0 - L * mix) * share);
+    }
+  };
+  if (!reuse)
+  {
+    parallel(n, 16384, [&](std::int64_t p0, std::int64_t p1) {
+      for (std::int64_t p = p0; p < p1; ++p)
       {
-        same = distance[l][p] == kept->Distance[l][p];
+        redo(p);
       }
-      if (same)
-      {
-        continue;
-      }
-      double total = 0.0;
-      int zeros = 0;
-      for (int l = 0; l < L; ++l)
-      {
-        const double d = distance[l][p];
-        zeros += d == 0.0;
-        total += d > 0.0 && std::isfinite(d) ? 1.0 / d : 0.0;
-      }
-      const double s = lambda * (size.empty() ? 1.0 : size[p]);
-      for (int l = 0; l < L; ++l)
-      {
-        const double d = distance[l][p];
-        const double share = zeros ? (d == 0.0 ? 1.0 / zeros : 0.0)
-                                   : (total > 0.0 ? (std::isfinite(d) ? 1.0 / d / total : 0.0) : 1.0 / L);
-        term[p * L + l] = s * -geo.Weight * std::log(mix + (1.0 - L * mix) * share);
-      }
+    });
+  }
+  else
+  {
+    // Each label's list names a node once; the lists run one after the other.
+    for (const std::vector<std::int64_t>& changed : changes.Nodes)
+    {
+      parallel(static_cast<std::int64_t>(changed.size()), 16384, [&](std::int64_t i0, std::int64_t i1) {
+        for (std::int64_t i = i0; i < i1; ++i)
+        {
+          redo(changed[i]);
+        }
+      });
+    }
+  }
+  parallel(n * L, 65536, [&](std::int64_t i0, std::int64_t i1) {
+    for (std::int64_t i = i0; i < i1; ++i)
+    {
+      cost[i] += term[i];
     }
   });
-  for (std::int64_t i = 0; i < n * L; ++i)
-  {
-    cost[i] += term[i];
-  }
-  if (kept)
-  {
-    kept->Distance = std::move(distance);
-  }
   return true;
 }
 

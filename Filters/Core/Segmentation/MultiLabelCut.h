@@ -111,11 +111,11 @@ struct MultiLabelResult
   bool Aborted = false;
 };
 
-// The seeds' spatial term of the last cut per node and label (nodes x labels), with the distances,
-// label count, weight, lambda and node sizes it was made from.
+// The seeds' spatial term of the last cut per node and label (nodes x labels), with the label
+// count, weight, lambda and node sizes it was made from; the geodesic cache beside it names the
+// nodes whose distances changed since.
 struct GeodesicTerm
 {
-  std::vector<std::vector<double>> Distance;
   std::vector<double> Term, Size;
   double Weight = 0.0, Lambda = 0.0;
   int Labels = 0;

@@ -187,7 +187,8 @@ private:
 // Distances from one kind of seeds, with the seed each node's shortest path starts from.
 struct DistanceField
 {
-  std::vector<double> Distance;
+  SharedArray<double> Distance; // shared with the callers that asked for it, copied before a change
+
   std::vector<std::int32_t> Root;   // -1 unreachable (fewer than 2^31 nodes)
   // Kept fields only (a new scale rescales them): each node's shortest path as its two sums, the
   // intensity steps (image units) and the travel (the adjacency's float steps), its distance
@@ -233,16 +234,16 @@ struct DistanceField
 
 // Relaxes the edge p -> q (of length `step`) in `field` at `inverse` = 1 / scale: true when it
 // shortens q's distance, which it then takes with p's root (and its sums, kept).
-inline bool Relax(DistanceField& field, const double* value, std::int64_t p, std::int64_t q, double step, double inverse,
-  double lengthWeight)
+inline bool Relax(DistanceField& field, double* distance, const double* value, std::int64_t p, std::int64_t q, double step,
+  double inverse, double lengthWeight)
 {
   const double rise = std::fabs(value[q] - value[p]);
   if (!field.KeepsSums)
   {
-    const double candidate = field.Distance[p] + rise * inverse + lengthWeight * step;
-    if (candidate < field.Distance[q])
+    const double candidate = distance[p] + rise * inverse + lengthWeight * step;
+    if (candidate < distance[q])
     {
-      field.Distance[q] = candidate;
+      distance[q] = candidate;
       field.Root[q] = field.Root[p];
       return true;
     }
@@ -250,9 +251,9 @@ inline bool Relax(DistanceField& field, const double* value, std::int64_t p, std
   }
   const double intensity = field.Intensity[p] + rise, travel = field.Travel[p] + step;
   const double candidate = intensity * inverse + lengthWeight * travel;
-  if (candidate < field.Distance[q])
+  if (candidate < distance[q])
   {
-    field.Distance[q] = candidate;
+    distance[q] = candidate;
     field.Root[q] = field.Root[p];
     field.Intensity[q] = intensity;
     field.Travel[q] = travel;
@@ -274,7 +275,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
   if (field.Distance.empty())
   {
     field.ChangeAll();
-    field.Distance.assign(n, std::numeric_limits<double>::infinity());
+    field.Distance = std::vector<double>(n, std::numeric_limits<double>::infinity());
     field.Root.assign(n, -1);
     if (field.KeepsSums)
     {
@@ -283,7 +284,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
     }
   }
   field.Scale = scale;
-  std::vector<double>& distance = field.Distance;
+  double* distance = field.Distance.Mutable().data();
   // Heap entries of 8 bytes: the distance rounded up to a float (non-negative floats order as
   // their bits, and a longer path never rounds to a smaller key) above the node. Equal keys may
   // pop a node before its last improvement; it is then pushed and expanded again, so the
@@ -329,7 +330,7 @@ bool Dijkstra(const GeodesicGraph& g, const Adjacency& adjacency, const std::vec
       return false;
     }
     adjacency.ForEach(p, [&](std::int64_t q, double step) {
-      if (Relax(field, value, p, q, step, inverse, lengthWeight))
+      if (Relax(field, distance, value, p, q, step, inverse, lengthWeight))
       {
         adjacency.Prefetch(q); // in cache by the time q pops
         field.Change(q);
@@ -356,7 +357,7 @@ bool Rescale(const GeodesicGraph& g, const Adjacency& adjacency, double scale, d
   const double* value = g.Value.data();
   const double inverse = 1.0 / scale;
   field.ChangeAll();
-  std::vector<double>& distance = field.Distance;
+  std::vector<double>& distance = field.Distance.Mutable();
   for (std::int64_t p = 0; p < n; ++p)
   {
     if (std::isfinite(distance[p]))
@@ -374,7 +375,7 @@ bool Rescale(const GeodesicGraph& g, const Adjacency& adjacency, double scale, d
       continue;
     }
     adjacency.ForEach(p, [&](std::int64_t q, double step) {
-      if (Relax(field, value, p, q, step, inverse, lengthWeight) && !((queued[q >> 6] >> (q & 63)) & 1u))
+      if (Relax(field, distance.data(), value, p, q, step, inverse, lengthWeight) && !((queued[q >> 6] >> (q & 63)) & 1u))
       {
         queued[q >> 6] |= std::uint64_t(1) << (q & 63);
         start.push_back(q);
@@ -412,11 +413,12 @@ bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::
       gone[r] = 1;
     }
     std::vector<std::int64_t> orphans;
+    double* distance = field.Distance.Mutable().data();
     for (std::int64_t p = 0; p < g.Nodes(); ++p)
     {
       if (field.Root[p] >= 0 && gone[field.Root[p]])
       {
-        field.Distance[p] = std::numeric_limits<double>::infinity();
+        distance[p] = std::numeric_limits<double>::infinity();
         field.Root[p] = -1;
         field.Change(p);
         orphans.push_back(p);
@@ -429,7 +431,7 @@ bool UpdateField(const GeodesicGraph& g, const Adjacency& adjacency, const std::
       adjacency.ForEach(p, [&](std::int64_t q, double step) {
         if (field.Root[q] >= 0)
         {
-          Relax(field, value, q, p, step, inverse, lengthWeight);
+          Relax(field, distance, value, q, p, step, inverse, lengthWeight);
         }
       });
       if (field.Root[p] >= 0)
@@ -503,7 +505,7 @@ std::vector<double> GeodesicDistances(const GeodesicGraph& graph, const std::vec
   {
     return {};
   }
-  return std::move(field.Distance);
+  return std::move(field.Distance.Mutable());
 }
 
 // With the graph copied when there is a cache, and `kinds` fields at least.
@@ -651,9 +653,9 @@ bool UpdateKinds(const GeodesicGraph& graph, std::vector<std::vector<std::int64_
 }
 } // namespace
 
-std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
+std::vector<SharedArray<double>> SeedKindDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
   int kinds, double scale, double lengthWeight, const ProgressFunction& progress, SeedGeodesicCache* cache,
-  const ParallelFor& parallel)
+  const ParallelFor& parallel, SeedDistanceChanges* changes)
 {
   scale = UsableScale(scale);
   std::shared_ptr<SeedGeodesicCache::Kept> kept = SeedGeodesicCache::Take(graph, lengthWeight, kinds, cache);
@@ -666,10 +668,29 @@ std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph& graph, c
   {
     return {};
   }
-  std::vector<std::vector<double>> distance(kinds);
+  std::vector<SharedArray<double>> distance(kinds);
   for (int k = 0; k < kinds; ++k)
   {
     distance[k] = kept->Field[k].Distance;
+  }
+  if (changes)
+  {
+    changes->All = !cache;
+    changes->Nodes.assign(kinds, {});
+    for (int k = 0; k < kinds; ++k)
+    {
+      DistanceField& field = kept->Field[k];
+      changes->All = changes->All || field.AllChanged;
+      changes->Nodes[k] = field.Changed;
+      if (cache)
+      {
+        field.Settle();
+      }
+    }
+    if (changes->All)
+    {
+      changes->Nodes.clear();
+    }
   }
   if (cache)
   {
@@ -698,8 +719,8 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
   // Each node's costs from its two distances, redone where either changed.
   DistanceField& fieldObject = kept->Field[0];
   DistanceField& fieldBackground = kept->Field[1];
-  const std::vector<double>& toObject = fieldObject.Distance;
-  const std::vector<double>& toBackground = fieldBackground.Distance;
+  const std::vector<double>& toObject = fieldObject.Distance.Vector();
+  const std::vector<double>& toBackground = fieldBackground.Distance.Vector();
   std::vector<double>& keptObject = kept->CostObject.Mutable();
   std::vector<double>& keptBackground = kept->CostBackground.Mutable();
   constexpr double mix = 0.01;

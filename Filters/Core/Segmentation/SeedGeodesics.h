@@ -48,6 +48,14 @@ struct GeodesicGraph
 std::vector<double> GeodesicDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
   std::uint8_t seedKind, double scale, double lengthWeight, const ProgressFunction& progress = NoProgress());
 
+// Which nodes' distances SeedKindDistances changed since the call before, per kind, each node once
+// per kind; or All.
+struct SeedDistanceChanges
+{
+  bool All = true;
+  std::vector<std::vector<std::int64_t>> Nodes;
+};
+
 // What the spatial term keeps for the next cut of the same graph (values, steps and length weight):
 // the adjacency, and per seed kind the seed nodes, their distances with the scale they are in, and
 // each node's root seed and the two sums of its path (intensity steps and travel: a kept distance is
@@ -63,8 +71,8 @@ public:
   struct Kept;
 
 private:
-  friend std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph&, const std::vector<std::uint8_t>&, int,
-    double, double, const ProgressFunction&, SeedGeodesicCache*, const ParallelFor&);
+  friend std::vector<SharedArray<double>> SeedKindDistances(const GeodesicGraph&, const std::vector<std::uint8_t>&, int,
+    double, double, const ProgressFunction&, SeedGeodesicCache*, const ParallelFor&, SeedDistanceChanges*);
   friend bool SeedGeodesicCosts(const GeodesicGraph&, const std::vector<std::uint8_t>&, double, const SeedGeodesicParameters&,
     const ParallelFor&, SharedArray<double>&, SharedArray<double>&, const ProgressFunction&, SeedGeodesicCache*);
   std::shared_ptr<Kept> State;
@@ -87,11 +95,13 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
 // Distances of every node from the seeds of each kind 1..kinds (hard[p] == kind), kept in `cache`
 // (optional) as SeedGeodesicCosts keeps its two kinds: a kind whose seeds changed is updated (added
 // seeds run Dijkstra from themselves, nodes rooted at removed ones restart from their neighbours),
-// the others reused; the kinds share `parallel`'s threads as SeedGeodesicCosts's two do. Empty
-// when progress asks to abort.
-std::vector<std::vector<double>> SeedKindDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
+// the others reused; the kinds share `parallel`'s threads as SeedGeodesicCosts's two do. The
+// distances are shared with the cache, which copies them before changing them while a holder has
+// them. `changes` (optional) receives what changed since the last call on this cache that asked
+// (All without a cache or before such a call). Empty when progress asks to abort.
+std::vector<SharedArray<double>> SeedKindDistances(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard,
   int kinds, double scale, double lengthWeight, const ProgressFunction& progress = NoProgress(),
-  SeedGeodesicCache* cache = nullptr, const ParallelFor& parallel = SerialFor());
+  SeedGeodesicCache* cache = nullptr, const ParallelFor& parallel = SerialFor(), SeedDistanceChanges* changes = nullptr);
 
 // Empty when usable, else a sentence.
 std::string ValidateParameters(const SeedGeodesicParameters& p);
