@@ -40,7 +40,10 @@ inline ProgressFunction NoProgress()
 inline bool BatchedFor(std::int64_t n, std::int64_t grain, const ParallelFor& parallel, const ProgressFunction& progress,
   const RangeFunction& body)
 {
-  const std::int64_t batches = 8, size = (n + batches - 1) / batches;
+  // Up to 8 batches, each of 64 grains at least: VTK 9.2's STDThread backend starts its threads for
+  // every loop, which costs more than a small batch's work.
+  const std::int64_t batches = std::max<std::int64_t>(1, std::min<std::int64_t>(8, n / (64 * std::max<std::int64_t>(grain, 1))));
+  const std::int64_t size = std::max<std::int64_t>(1, (n + batches - 1) / batches);
   for (std::int64_t b = 0; b < n; b += size)
   {
     const std::int64_t e = std::min(n, b + size);
