@@ -550,10 +550,16 @@ namespace
 // this one reports the runs' mean progress every 50 ms over [0, 0.9] (VTK 9.2's STDThread backend
 // does not run a loop on the calling thread, so a run there could not report) and, when progress asks to
 // abort, makes every run's progress return false; false then. A run's progress is called on the
-// thread it runs on and must only record. What the runs throw is rethrown here.
+// thread it runs on and must only record. What the runs throw is rethrown here. A single run runs
+// on this thread and reports through `progress` itself.
 bool RunReportingHere(std::int64_t count, const ParallelFor& parallel, const ProgressFunction& progress,
   const std::function<bool(std::int64_t, const ProgressFunction&)>& run)
 {
+  if (count == 1)
+  {
+    // One run (a seed edit of one kind): on this thread, reporting itself, with no thread to start.
+    return run(0, [&](double t) { return progress(0.9 * t); }) && progress(0.9);
+  }
   std::unique_ptr<std::atomic<double>[]> fraction(new std::atomic<double>[count]);
   for (std::int64_t i = 0; i < count; ++i)
   {
