@@ -947,10 +947,10 @@ bool RegionCosts(const CutProblem& pr, const HistogramBins& bin, const BinCosts&
   return true;
 }
 
-// Step 5: the seeds' spatial term (when its weight is positive) added to the region costs; it moves
+// Step 5: the seeds' spatial term per voxel of each node (empty when its weight is 0); it moves
 // terminal capacities only, so a kept flow still applies. False when progress asked to abort.
-bool AddSeedGeodesicTerm(const CutProblem& pr, double range, SeedGeodesicCache* kept, double* regionObject,
-  double* regionBackground, const ProgressFunction& progress, double& seconds)
+bool SeedGeodesicTerm(const CutProblem& pr, double range, SeedGeodesicCache* kept, SharedArray<double>& spatialObject,
+  SharedArray<double>& spatialBackground, const ProgressFunction& progress, double& seconds)
 {
   if (!(pr.Geodesic.Weight > 0.0))
   {
@@ -961,16 +961,9 @@ bool AddSeedGeodesicTerm(const CutProblem& pr, double range, SeedGeodesicCache* 
   graph.Edges = &pr.Edges;
   graph.Value = pr.Value;
   graph.Step = pr.Step;
-  SharedArray<double> spatialObject, spatialBackground;
   if (!SeedGeodesicCosts(graph, pr.Hard, range, pr.Geodesic, pr.Parallel, spatialObject, spatialBackground, progress, kept))
   {
     return false;
-  }
-  for (std::int64_t p = 0; p < static_cast<std::int64_t>(spatialObject.size()); ++p)
-  {
-    const double size = pr.Size.empty() ? 1.0 : pr.Size[p];
-    regionObject[p] += size * spatialObject[p];
-    regionBackground[p] += size * spatialBackground[p];
   }
   seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return true;
@@ -1064,13 +1057,22 @@ std::shared_ptr<MaxFlowCache::Kept> NewKept(const CutProblem& pr, double sigmaPa
   kept->WeightTotal = weightTotal;
   return kept;
 }
-// Step 5b: lambda times both region costs, and K's share of them (the larger per node) added to
-// `total`. False when progress asked to abort.
-bool ScaleRegionCosts(double lambda, std::int64_t n, double* regionObject, double* regionBackground, double& total,
-  const ProgressFunction& progress)
+// Step 5b: the spatial term (per voxel, when there is one) added to both region costs, lambda
+// times their sums, and K's share of them (the larger per node) added to `total`, in one pass.
+// False when progress asked to abort.
+bool ScaleRegionCosts(const CutProblem& pr, const SharedArray<double>& spatialObject,
+  const SharedArray<double>& spatialBackground, double lambda, std::int64_t n, double* regionObject,
+  double* regionBackground, double& total, const ProgressFunction& progress)
 {
+  const bool spatial = !spatialObject.empty();
   for (std::int64_t p = 0; p < n; ++p)
   {
+    if (spatial)
+    {
+      const double size = pr.Size.empty() ? 1.0 : pr.Size[p];
+      regionObject[p] += size * spatialObject[p];
+      regionBackground[p] += size * spatialBackground[p];
+    }
     regionObject[p] *= lambda;
     regionBackground[p] *= lambda;
     total += std::max(regionObject[p], regionBackground[p]);
@@ -1139,11 +1141,13 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   std::unique_ptr<double[]> regionObject(new double[n]), regionBackground(new double[n]);
   AdviseHugePages(regionObject.get(), n * sizeof(double));
   AdviseHugePages(regionBackground.get(), n * sizeof(double));
+  SharedArray<double> spatialObject, spatialBackground;
   if (aborted(RegionCosts(pr, bin, costs, low, width, cache ? &cache->Binned : nullptr, regionObject.get(),
         regionBackground.get(), SubProgress(progress, 0.2, 0.3))) ||
-    aborted(AddSeedGeodesicTerm(pr, lattice.HistogramHigh() - lattice.HistogramLow(), cache ? &cache->Geodesic : nullptr, regionObject.get(), regionBackground.get(),
-      SubProgress(progress, 0.3, 0.33), r.GeodesicSeconds)) ||
-    aborted(ScaleRegionCosts(par.Lambda, n, regionObject.get(), regionBackground.get(), total, SubProgress(progress, 0.33, 0.35))) ||
+    aborted(SeedGeodesicTerm(pr, lattice.HistogramHigh() - lattice.HistogramLow(), cache ? &cache->Geodesic : nullptr,
+      spatialObject, spatialBackground, SubProgress(progress, 0.3, 0.33), r.GeodesicSeconds)) ||
+    aborted(ScaleRegionCosts(pr, spatialObject, spatialBackground, par.Lambda, n, regionObject.get(), regionBackground.get(),
+      total, SubProgress(progress, 0.33, 0.35))) ||
     aborted(progress(0.35)))
   {
     return r;
@@ -1156,9 +1160,20 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     return r;
   }
   // 6. Terminal capacities (source = object: a node left on the source side pays its sink
-  // capacity), on the kept flow when only they changed, else on a new graph.
-  auto source = [&](std::int64_t p) { return pr.Hard[p] == 1 ? K : (pr.Hard[p] == 2 ? 0.0 : regionBackground[p]); };
-  auto sink = [&](std::int64_t p) { return pr.Hard[p] == 2 ? K : (pr.Hard[p] == 1 ? 0.0 : regionObject[p]); };
+  // capacity), in place of the region costs they are made of, then on the kept flow when only they
+  // changed, else on a new graph. A seed's are K to its own side and 0 to the other.
+  double* const sourceCapacity = regionBackground.get();
+  double* const sinkCapacity = regionObject.get();
+  for (std::int64_t p = 0; p < n; ++p)
+  {
+    if (pr.Hard[p] == 1 || pr.Hard[p] == 2)
+    {
+      sourceCapacity[p] = pr.Hard[p] == 1 ? K : 0.0;
+      sinkCapacity[p] = pr.Hard[p] == 2 ? K : 0.0;
+    }
+  }
+  auto source = [sourceCapacity](std::int64_t p) { return sourceCapacity[p]; };
+  auto sink = [sinkCapacity](std::int64_t p) { return sinkCapacity[p]; };
   if (cache)
   {
     cache->State.reset(); // until this cut's flow has finished
@@ -1210,13 +1225,6 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     kept->Size = pr.Size;
     kept->Step = pr.Step;
     kept->Graph = g;
-    // The capacities in place of the region costs they were made of (a node's read its own only).
-    for (std::int64_t p = 0; p < n; ++p)
-    {
-      const double s = source(p), t = sink(p);
-      regionBackground[p] = s;
-      regionObject[p] = t;
-    }
     kept->Source = std::move(regionBackground);
     kept->Sink = std::move(regionObject);
     cache->State = kept;
