@@ -460,6 +460,20 @@ std::vector<std::int64_t> SeedNodes(const std::vector<std::uint8_t>& hard, std::
   }
   return seeds;
 }
+
+// The seed nodes of each kind 1..kinds, ascending, from one pass over `hard`.
+std::vector<std::vector<std::int64_t>> SeedNodesOfKinds(const std::vector<std::uint8_t>& hard, int kinds)
+{
+  std::vector<std::vector<std::int64_t>> seeds(kinds);
+  for (std::int64_t p = 0; p < static_cast<std::int64_t>(hard.size()); ++p)
+  {
+    if (hard[p] >= 1 && hard[p] <= kinds)
+    {
+      seeds[hard[p] - 1].push_back(p);
+    }
+  }
+  return seeds;
+}
 } // namespace
 
 struct SeedGeodesicCache::Kept
@@ -665,11 +679,7 @@ std::vector<SharedArray<double>> SeedKindDistances(const GeodesicGraph& graph, c
 {
   scale = UsableScale(scale);
   std::shared_ptr<SeedGeodesicCache::Kept> kept = SeedGeodesicCache::Take(graph, lengthWeight, kinds, cache);
-  std::vector<std::vector<std::int64_t>> seeds(kinds);
-  for (int k = 0; k < kinds; ++k)
-  {
-    seeds[k] = SeedNodes(hard, static_cast<std::uint8_t>(k + 1));
-  }
+  std::vector<std::vector<std::int64_t>> seeds = SeedNodesOfKinds(hard, kinds);
   if (!UpdateKinds(graph, std::move(seeds), scale, lengthWeight, parallel, progress, *kept))
   {
     return {};
@@ -711,7 +721,7 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
 {
   costObject = SharedArray<double>();
   costBackground = SharedArray<double>();
-  std::vector<std::vector<std::int64_t>> seeds{ SeedNodes(hard, 1), SeedNodes(hard, 2) };
+  std::vector<std::vector<std::int64_t>> seeds = SeedNodesOfKinds(hard, 2);
   if (par.Weight <= 0.0 || seeds[0].empty() || seeds[1].empty() || graph.Nodes() == 0)
   {
     return true;
