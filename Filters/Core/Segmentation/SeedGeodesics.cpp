@@ -188,7 +188,6 @@ private:
 struct DistanceField
 {
   SharedArray<double> Distance; // shared with the callers that asked for it, copied before a change
-
   std::vector<std::int32_t> Root;   // -1 unreachable (fewer than 2^31 nodes)
   // Kept fields only (a new scale rescales them): each node's shortest path as its two sums, the
   // intensity steps (image units) and the travel (the adjacency's float steps), its distance

@@ -86,7 +86,7 @@ private:
 // is then reported between them only). False when progress asks to abort; true with empty costs
 // when Weight is 0 or either seed kind is absent. `cache` (optional) keeps what the next cut reuses,
 // the costs among it: they are shared with the cache, which redoes them where the distances changed
-// unless a holder still has them.
+// (on a copy while a holder still has them).
 bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_t>& hard, double scale,
   const SeedGeodesicParameters& parameters, const ParallelFor& parallel, SharedArray<double>& costObject,
   SharedArray<double>& costBackground, const ProgressFunction& progress = NoProgress(),
