@@ -242,16 +242,7 @@ bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, 
   }
   else
   {
-    // Each label's list names a node once; the lists run one after the other.
-    for (const std::vector<std::int64_t>& changed : changes.Nodes)
-    {
-      parallel(static_cast<std::int64_t>(changed.size()), 16384, [&](std::int64_t i0, std::int64_t i1) {
-        for (std::int64_t i = i0; i < i1; ++i)
-        {
-          redo(changed[i]);
-        }
-      });
-    }
+    ForEachChangedNode(changes, parallel, redo);
   }
   parallel(n * L, 65536, [&](std::int64_t i0, std::int64_t i1) {
     for (std::int64_t i = i0; i < i1; ++i)

@@ -215,8 +215,9 @@ struct DistanceField
     std::vector<std::int64_t>().swap(this->Changed);
     std::vector<std::uint8_t>().swap(this->Marked);
   }
-  // What changed so far has been taken into account: record changes from here on.
-  void Settle()
+  // The nodes changed since the last Settle() (empty when AllChanged), handed over: changes are
+  // recorded afresh from here on.
+  std::vector<std::int64_t> Settle()
   {
     if (this->AllChanged)
     {
@@ -226,8 +227,8 @@ struct DistanceField
     {
       this->Marked[p] = 0;
     }
-    this->Changed.clear();
     this->AllChanged = false;
+    return std::exchange(this->Changed, {});
   }
 };
 
@@ -473,6 +474,27 @@ std::vector<std::vector<std::int64_t>> SeedNodesOfKinds(const std::vector<std::u
   }
   return seeds;
 }
+
+// What the first `kinds` fields changed since the last call; a kept record's fields then record
+// afresh, a fresh record (no cache) changed All.
+SeedDistanceChanges TakeChanges(std::vector<DistanceField>& fields, int kinds, bool kept)
+{
+  SeedDistanceChanges changes;
+  changes.All = !kept;
+  for (int k = 0; k < kinds; ++k)
+  {
+    changes.All = changes.All || fields[k].AllChanged;
+  }
+  for (int k = 0; k < kinds && kept; ++k)
+  {
+    changes.Nodes.push_back(fields[k].Settle());
+  }
+  if (changes.All)
+  {
+    changes.Nodes.clear();
+  }
+  return changes;
+}
 } // namespace
 
 struct SeedGeodesicCache::Kept
@@ -690,22 +712,7 @@ std::vector<SharedArray<double>> SeedKindDistances(const GeodesicGraph& graph, c
   }
   if (changes)
   {
-    changes->All = !cache;
-    changes->Nodes.assign(kinds, {});
-    for (int k = 0; k < kinds; ++k)
-    {
-      DistanceField& field = kept->Field[k];
-      changes->All = changes->All || field.AllChanged;
-      changes->Nodes[k] = field.Changed;
-      if (cache)
-      {
-        field.Settle();
-      }
-    }
-    if (changes->All)
-    {
-      changes->Nodes.clear();
-    }
+    *changes = TakeChanges(kept->Field, kinds, cache != nullptr);
   }
   if (cache)
   {
@@ -732,10 +739,8 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
     return false;
   }
   // Each node's costs from its two distances, redone where either changed.
-  DistanceField& fieldObject = kept->Field[0];
-  DistanceField& fieldBackground = kept->Field[1];
-  const std::vector<double>& toObject = fieldObject.Distance.Vector();
-  const std::vector<double>& toBackground = fieldBackground.Distance.Vector();
+  const std::vector<double>& toObject = kept->Field[0].Distance.Vector();
+  const std::vector<double>& toBackground = kept->Field[1].Distance.Vector();
   std::vector<double>& keptObject = kept->CostObject.Mutable();
   std::vector<double>& keptBackground = kept->CostBackground.Mutable();
   constexpr double mix = 0.01;
@@ -751,8 +756,8 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
     keptBackground[p] = -par.Weight * std::log(mix + (1.0 - 2.0 * mix) * (1.0 - object));
   };
   const std::int64_t n = graph.Nodes();
-  if (fieldObject.AllChanged || fieldBackground.AllChanged || kept->CostWeight != par.Weight ||
-    static_cast<std::int64_t>(keptObject.size()) != n)
+  const SeedDistanceChanges changes = TakeChanges(kept->Field, 2, cache != nullptr);
+  if (changes.All || kept->CostWeight != par.Weight || static_cast<std::int64_t>(keptObject.size()) != n)
   {
     keptObject.resize(n);
     keptBackground.resize(n);
@@ -765,23 +770,9 @@ bool SeedGeodesicCosts(const GeodesicGraph& graph, const std::vector<std::uint8_
   }
   else
   {
-    // Each list names a node once; the two lists run one after the other.
-    for (const std::vector<std::int64_t>* changed : { &fieldObject.Changed, &fieldBackground.Changed })
-    {
-      parallel(static_cast<std::int64_t>(changed->size()), 16384, [&](std::int64_t i0, std::int64_t i1) {
-        for (std::int64_t i = i0; i < i1; ++i)
-        {
-          cost((*changed)[i]);
-        }
-      });
-    }
+    ForEachChangedNode(changes, parallel, cost);
   }
   kept->CostWeight = par.Weight;
-  if (cache)
-  {
-    fieldObject.Settle();
-    fieldBackground.Settle();
-  }
   costObject = kept->CostObject;
   costBackground = kept->CostBackground;
   if (cache)

@@ -56,6 +56,22 @@ struct SeedDistanceChanges
   std::vector<std::vector<std::int64_t>> Nodes;
 };
 
+// f(p) for every node the changes list, on `parallel`'s threads, one kind's list after another (a
+// node listed for two kinds is visited twice, never by two threads at once).
+template <typename F>
+void ForEachChangedNode(const SeedDistanceChanges& changes, const ParallelFor& parallel, F&& f)
+{
+  for (const std::vector<std::int64_t>& nodes : changes.Nodes)
+  {
+    parallel(static_cast<std::int64_t>(nodes.size()), 16384, [&](std::int64_t first, std::int64_t last) {
+      for (std::int64_t i = first; i < last; ++i)
+      {
+        f(nodes[i]);
+      }
+    });
+  }
+}
+
 // What the spatial term keeps for the next cut of the same graph (values, steps and length weight):
 // the adjacency, and per seed kind the seed nodes, their distances with the scale they are in, and
 // each node's root seed and the two sums of its path (intensity steps and travel: a kept distance is
