@@ -5,6 +5,7 @@
 #include "SeedConnectivity.h"
 #include "SeedGeodesics.h"
 #include "SuperVoxelCut.h"
+#include "VoxelRefinement.h"
 #include "ElementRasterizer.h"
 #include "ImageFilters.h"
 #include "DelaunayImageMesh.h"
@@ -1094,4 +1095,215 @@ TEST(SeedGeodesics, DistancesAddTheStepsAndTheLength)
   EXPECT_TRUE(costObject.empty());
   p.Weight = -1;
   EXPECT_FALSE(ValidateParameters(p).empty());
+}
+
+namespace
+{
+// A random mesh of a 40 x 40 image whose elements take the majority label of `truth` (one disk, or
+// two: labels 1 and 2), with its owner map.
+struct RefinementCase
+{
+  ImageGeometry G = Grid2(40, 40);
+  SimplexMesh Mesh;
+  SuperVoxelCutData Data;
+  std::vector<std::uint8_t> Truth, Element;
+  std::vector<float> Value;
+
+  explicit RefinementCase(bool twoObjects)
+  {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(0.0, 39.0);
+    std::vector<std::array<double, 3>> pts;
+    for (int n = 0; n < 160; ++n)
+      pts.push_back({ { u(rng), u(rng), 0.0 } });
+    for (int c = 0; c < 4; ++c)
+      pts.push_back({ { (c & 1) ? 39.0 : 0.0, (c & 2) ? 39.0 : 0.0, 0.0 } });
+    EXPECT_TRUE(CGALMeshOfNodes(G, pts, Mesh));
+    std::string error;
+    EXPECT_TRUE(PrepareSuperVoxelCut(Mesh, static_cast<const double*>(nullptr), Data, error, SerialFor()));
+    Truth.assign(G.Size(), 0);
+    Value.assign(G.Size(), 10.f);
+    for (int j = 0; j < 40; ++j)
+      for (int i = 0; i < 40; ++i)
+      {
+        const std::int64_t v = G.Index(i, j, 0);
+        if (std::hypot(i - 14.3, j - 15.1) <= 8.6)
+          Truth[v] = 1;
+        else if (twoObjects && std::hypot(i - 29.2, j - 27.7) <= 6.4)
+          Truth[v] = 2;
+        Value[v] = 10.f + 40.f * Truth[v];
+      }
+    const std::int64_t m = Mesh.NumberOfElements();
+    std::vector<std::array<int, 3>> votes(m, { { 0, 0, 0 } });
+    for (std::int64_t v = 0; v < G.Size(); ++v)
+      ++votes[Data.Owner[v]][Truth[v]];
+    Element.resize(m);
+    for (std::int64_t e = 0; e < m; ++e)
+      Element[e] = static_cast<std::uint8_t>(std::max_element(votes[e].begin(), votes[e].end()) - votes[e].begin());
+  }
+  // The elements with a face neighbour of another label.
+  std::vector<std::uint8_t> Boundary() const
+  {
+    const FaceAdjacency& f = *Mesh.SharedFaces();
+    std::vector<std::uint8_t> b(Element.size(), 0);
+    for (std::size_t k = 0; k < f.A.size(); ++k)
+      if (Element[f.A[k]] != Element[f.B[k]])
+        b[f.A[k]] = b[f.B[k]] = 1;
+    return b;
+  }
+  VoxelRefinementProblem Problem(int labels)
+  {
+    VoxelRefinementProblem p;
+    p.Mesh = &Mesh;
+    p.Owner = &Data.Owner;
+    p.Label = &Element;
+    p.Labels = labels;
+    p.Cost = [this, labels](std::int64_t v, std::int64_t, double* c) {
+      for (int l = 0; l < labels; ++l)
+        c[l] = l == Truth[v] ? 0.0 : 1.0;
+    };
+    p.Distance2 = [this](std::int64_t a, std::int64_t b) { return double(Value[a] - Value[b]) * (Value[a] - Value[b]); };
+    p.Sigma = 1e-3; // a weight of 1 between equal values, 0 across the objects' edges
+    return p;
+  }
+  std::vector<std::uint8_t> Labelled(const VoxelRefinementResult& r) const
+  {
+    std::vector<std::uint8_t> out(G.Size());
+    VoxelLabels(Data.Owner, Element, out.data(), SerialFor());
+    ApplyRefinement(r, out.data());
+    return out;
+  }
+};
+} // namespace
+
+TEST(VoxelRefinement, TheBandFollowsTheVoxelsAndTheRestKeepsItsElements)
+{
+  // Costs that favour each voxel's true label and weights that vanish across the objects' edges:
+  // every voxel of an element along the cut takes its true label, every other voxel its element's,
+  // the seeds' elements keep theirs, and any split of the loops gives the same voxels.
+  for (const bool two : { false, true })
+  {
+    RefinementCase c(two);
+    const std::vector<std::uint8_t> boundary = c.Boundary();
+    VoxelRefinementProblem p = c.Problem(two ? 3 : 2);
+    std::int64_t fixed = -1;
+    for (std::size_t e = 0; e < boundary.size() && fixed < 0; ++e)
+      fixed = boundary[e] ? static_cast<std::int64_t>(e) : -1;
+    p.Fixed.assign(c.Element.size(), 0);
+    p.Fixed[fixed] = 1;
+    const VoxelRefinementResult serial = RefineOnVoxels(p);
+    ASSERT_TRUE(serial.Error.empty()) << serial.Error;
+    const std::vector<std::uint8_t> labels = c.Labelled(serial);
+    std::int64_t band = 0, changed = 0;
+    for (std::int64_t v = 0; v < c.G.Size(); ++v)
+    {
+      const std::int32_t e = c.Data.Owner[v];
+      const bool refined = boundary[e] && e != fixed;
+      band += refined;
+      changed += refined && c.Truth[v] != c.Element[e];
+      EXPECT_EQ(labels[v], refined ? c.Truth[v] : c.Element[e]) << "voxel " << v;
+    }
+    EXPECT_EQ(serial.BandVoxels, band);
+    EXPECT_EQ(static_cast<std::int64_t>(serial.Voxel.size()), changed);
+    EXPECT_GT(changed, 20);
+    p.Parallel = Chunked;
+    VoxelRefinementCache cache;
+    for (int run = 0; run < 2; ++run) // the second with the cache's kept buffers
+    {
+      const VoxelRefinementResult split = RefineOnVoxels(p, NoProgress(), &cache);
+      EXPECT_EQ(split.Voxel, serial.Voxel);
+      EXPECT_EQ(split.Label, serial.Label);
+      EXPECT_EQ(split.Energy, serial.Energy);
+    }
+  }
+}
+
+TEST(VoxelRefinement, ExpansionLowersTheBandsEnergy)
+{
+  // Three labels with weights between equal values: the refined voxels' energy (their costs and a
+  // weight per face between two labels, the voxels outside the band held) is no higher than the
+  // elements' labels give, and labels only move where the band lies.
+  RefinementCase c(true);
+  VoxelRefinementProblem p = c.Problem(3);
+  p.Sigma = 20.0;
+  const VoxelRefinementResult r = RefineOnVoxels(p);
+  ASSERT_TRUE(r.Error.empty()) << r.Error;
+  const std::vector<std::uint8_t> boundary = c.Boundary();
+  std::vector<std::uint8_t> before(c.G.Size());
+  VoxelLabels(c.Data.Owner, c.Element, before.data(), SerialFor());
+  const std::vector<std::uint8_t> after = c.Labelled(r);
+  auto energy = [&](const std::vector<std::uint8_t>& x) {
+    double sum = 0.0;
+    for (std::int64_t v = 0; v < c.G.Size(); ++v)
+    {
+      if (!boundary[c.Data.Owner[v]])
+        continue;
+      sum += x[v] == c.Truth[v] ? 0.0 : 1.0;
+      const std::array<int, 3> ijk = c.G.Coordinates(v);
+      for (const std::array<int, 2>& d : { std::array<int, 2>{ { 1, 0 } }, std::array<int, 2>{ { -1, 0 } },
+             std::array<int, 2>{ { 0, 1 } }, std::array<int, 2>{ { 0, -1 } } })
+      {
+        if (!c.G.Contains(ijk[0] + d[0], ijk[1] + d[1], 0))
+          continue;
+        const std::int64_t u = c.G.Index(ijk[0] + d[0], ijk[1] + d[1], 0);
+        const bool inner = boundary[c.Data.Owner[u]];
+        if ((inner && u < v) || x[u] == x[v])
+          continue; // each pair within the band once
+        const double d2 = p.Distance2(u, v);
+        sum += d2 == 0.0 ? 1.0 : std::exp(-d2 / (2.0 * p.Sigma * p.Sigma));
+      }
+    }
+    return sum;
+  };
+  EXPECT_LT(energy(after), energy(before));
+  EXPECT_NEAR(energy(after), r.Energy, 1e-9 * (1.0 + r.Energy));
+  for (std::int64_t v = 0; v < c.G.Size(); ++v)
+    if (!boundary[c.Data.Owner[v]])
+      EXPECT_EQ(after[v], before[v]);
+}
+
+TEST(VoxelRefinement, PiecesTheirLabelDoesNotReachTakeTheirNeighbours)
+{
+  // A voxel of the background side made cheap as object, away from the object: Off keeps it as a
+  // speck of object, Seeded Object and Fill Holes' rule for the background give it back.
+  RefinementCase c(false);
+  const std::vector<std::uint8_t> boundary = c.Boundary();
+  std::int64_t speck = -1;
+  for (std::int64_t v = 0; v < c.G.Size() && speck < 0; ++v)
+  {
+    const std::array<int, 3> ijk = c.G.Coordinates(v);
+    bool alone = boundary[c.Data.Owner[v]] && c.Truth[v] == 0 && ijk[0] > 0 && ijk[1] > 0 && ijk[0] < 39 && ijk[1] < 39;
+    for (const std::int64_t u : { v - 1, v + 1, v - 40, v + 40 })
+      alone = alone && c.Truth[u] == 0 && (boundary[c.Data.Owner[u]] || c.Element[c.Data.Owner[u]] == 0);
+    speck = alone ? v : -1;
+  }
+  ASSERT_GE(speck, 0);
+  c.Value[speck] = 1000.f; // no weight to its neighbours
+  VoxelRefinementProblem p = c.Problem(2);
+  p.Cost = [&](std::int64_t v, std::int64_t, double* x) {
+    const int want = v == speck ? 1 : c.Truth[v];
+    x[0] = want == 0 ? 0.0 : 1.0;
+    x[1] = want == 1 ? 0.0 : 1.0;
+  };
+  p.Connectivity = Connectivity::Off;
+  EXPECT_EQ(c.Labelled(RefineOnVoxels(p))[speck], 1);
+  p.Connectivity = Connectivity::SeededObject;
+  EXPECT_EQ(c.Labelled(RefineOnVoxels(p))[speck], 0);
+  p.Connectivity = Connectivity::FillHoles; // an object piece is kept
+  EXPECT_EQ(c.Labelled(RefineOnVoxels(p))[speck], 1);
+}
+
+TEST(VoxelRefinement, BadInputsAreASentence)
+{
+  RefinementCase c(false);
+  VoxelRefinementProblem p = c.Problem(2);
+  p.Sigma = 0.0;
+  EXPECT_FALSE(RefineOnVoxels(p).Error.empty());
+  p = c.Problem(2);
+  std::vector<std::uint8_t> shorter(c.Element.begin(), c.Element.end() - 1);
+  p.Label = &shorter;
+  EXPECT_FALSE(RefineOnVoxels(p).Error.empty());
+  p = c.Problem(2);
+  p.Rings = 0;
+  EXPECT_FALSE(RefineOnVoxels(p).Error.empty());
 }

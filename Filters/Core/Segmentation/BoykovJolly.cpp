@@ -587,11 +587,7 @@ public:
   }
   // Clamped before the conversion: a value far beyond the range (an outlier a billion bins away)
   // must not overflow the int, which would put it in bin 0 and stall the runs above.
-  int operator()(double v) const
-  {
-    const double q = (v - this->Low) / this->Width;
-    return q < 1.0 ? 0 : (q >= this->Count - 1 ? this->Count - 1 : static_cast<int>(q));
-  }
+  int operator()(double v) const { return ValueBins{ this->Count, this->Low, this->Width }(v); }
   // The smallest value of bin b (b in [0, Size()]; -inf and +inf at the ends).
   double First(int b) const { return this->Start[b]; }
 
@@ -1215,6 +1211,11 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   }
   r.Flow = flow.first;
   r.Label = std::move(flow.second);
+  r.ValueBin = ValueBins{ lattice.Size, low, width };
+  r.BinCostObject = costs.Object;
+  r.BinCostBackground = costs.Background;
+  r.SpatialObject = spatialObject;
+  r.SpatialBackground = spatialBackground;
   // 8. What a re-cut with other seeds reuses: the graph, its weights and its capacities.
   if (cache)
   {

@@ -116,6 +116,20 @@ struct CutProblem
   ParallelFor Parallel = SerialFor();
 };
 
+// The lattice bin of a value: Count bins of Width from Low, the end bins open.
+struct ValueBins
+{
+  int Count = 1;
+  double Low = 0.0, Width = 1.0;
+  // Clamped before the conversion: a value far beyond the range (an outlier a billion bins away)
+  // must not overflow the int.
+  int operator()(double v) const
+  {
+    const double q = (v - this->Low) / this->Width;
+    return q < 1.0 ? 0 : (q >= this->Count - 1 ? this->Count - 1 : static_cast<int>(q));
+  }
+};
+
 struct CutResult
 {
   std::vector<std::uint8_t> Label; // 1 object, 0 background
@@ -127,6 +141,11 @@ struct CutResult
   // components' sizes in voxels, largest first.
   std::int64_t ConnectivityChanged = 0;
   std::vector<double> ObjectComponentVoxels;
+  // The region term of a voxel value, -ln Pr(x | label) = BinCost...[ValueBin(x)], and the spatial
+  // term per voxel of each node (empty without one), before lambda: the voxel refinement's terms.
+  ValueBins ValueBin;
+  std::vector<double> BinCostObject, BinCostBackground;
+  SharedArray<double> SpatialObject, SpatialBackground;
   std::string Error;
   bool Aborted = false;
 };

@@ -169,7 +169,7 @@ std::vector<double> PottsWeights(const GraphEdges& edges, const std::vector<doub
 bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, const ChannelBins& bins,
   const SharedArray<double>& step, const std::vector<std::int16_t>& hard, int L, const SeedGeodesicParameters& geo,
   double lambda, const std::vector<double>& size, std::vector<double>& cost, const ParallelFor& parallel,
-  const ProgressFunction& progress, MultiLabelCache* cache)
+  const ProgressFunction& progress, MultiLabelCache* cache, SharedArray<double>& added)
 {
   const std::int64_t n = static_cast<std::int64_t>(hard.size());
   const int channels = bins.Channels;
@@ -208,10 +208,10 @@ bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, 
     kept->Weight = geo.Weight;
     kept->Lambda = lambda;
     kept->Size = size;
-    kept->Term.assign(n * L, 0.0);
+    kept->Term = SharedArray<double>(std::vector<double>(n * L, 0.0));
   }
   std::vector<double> own(kept ? 0 : n * L);
-  std::vector<double>& term = kept ? kept->Term : own;
+  std::vector<double>& term = kept ? kept->Term.Mutable() : own;
   const double mix = 0.01;
   const auto redo = [&](std::int64_t p) {
     double total = 0.0;
@@ -250,6 +250,7 @@ bool AddGeodesicCosts(const GraphEdges& edges, const std::vector<double>& mean, 
       cost[i] += term[i];
     }
   });
+  added = kept ? kept->Term : SharedArray<double>(std::move(own));
   return true;
 }
 
@@ -361,7 +362,7 @@ void SolveLabels(PottsProblem& pr, std::vector<std::int16_t> hard, const std::ve
   {
     const auto g0 = Clock::now();
     if (!AddGeodesicCosts(edges, mean, bins, step, hard, pr.Labels, par.Geodesic, par.Lambda, size, pr.Cost, parallel,
-          SubProgress(progress, 0.0, 0.2), cache))
+          SubProgress(progress, 0.0, 0.2), cache, r.Spatial))
     {
       r.Aborted = true;
       return;
@@ -906,6 +907,7 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
   {
     return r;
   }
+  r.BinCosts = costs;
   r.BoundaryFaces = LabelBoundaryFaces(mesh, *faces, r.Label);
   return r;
 }

@@ -107,6 +107,11 @@ struct MultiLabelResult
   double SetupSeconds = 0.0, ExpansionSeconds = 0.0, GeodesicSeconds = 0.0;
   std::int64_t ConnectivityChanged = 0;
   std::vector<std::int64_t> BoundaryFaces; // super-voxel cut: faces between labels and labels' hull faces
+  // The voxel refinement's terms (super-voxel cut): each label's -ln Pr per joint bin, and each
+  // node's spatial term per label as the expansion paid it (nodes x labels, lambda x size x the
+  // term per voxel; empty without one).
+  std::vector<std::vector<double>> BinCosts;
+  SharedArray<double> Spatial;
   std::string Error;
   bool Aborted = false;
 };
@@ -116,7 +121,8 @@ struct MultiLabelResult
 // nodes whose distances changed since.
 struct GeodesicTerm
 {
-  std::vector<double> Term, Size;
+  SharedArray<double> Term;
+  std::vector<double> Size;
   double Weight = 0.0, Lambda = 0.0;
   int Labels = 0;
 };

@@ -88,7 +88,7 @@ std::vector<std::int64_t> LabelComponents(const std::vector<std::uint8_t>& label
 std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label, const GraphEdges& edges,
   const std::vector<std::uint8_t>& hard,
   const std::vector<std::uint8_t>& border, const ProgressFunction& progress, std::vector<double>* objectSizes,
-  const std::vector<double>& size)
+  const std::vector<double>& size, std::vector<std::int64_t>* objectComponent)
 {
   if (mode == Connectivity::Off && !objectSizes)
   {
@@ -201,14 +201,30 @@ std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& lab
       }
     }
     objectSizes->clear();
+    std::vector<std::int64_t> roots;
     for (std::int64_t c = 0; c < count; ++c)
     {
       if (value[c] == 1 && root[c] == c)
       {
-        objectSizes->push_back(sum[c]);
+        roots.push_back(c);
       }
     }
-    std::sort(objectSizes->begin(), objectSizes->end(), std::greater<double>());
+    // Largest first; equal sizes in order of their first node.
+    std::stable_sort(roots.begin(), roots.end(), [&](std::int64_t a, std::int64_t b) { return sum[a] > sum[b]; });
+    std::vector<std::int64_t> rank(count, -1);
+    for (std::size_t k = 0; k < roots.size(); ++k)
+    {
+      objectSizes->push_back(sum[roots[k]]);
+      rank[roots[k]] = static_cast<std::int64_t>(k);
+    }
+    if (objectComponent)
+    {
+      objectComponent->resize(n);
+      for (std::int64_t p = 0; p < n; ++p)
+      {
+        (*objectComponent)[p] = value[id[p]] == 1 ? rank[root[id[p]]] : -1;
+      }
+    }
   }
   return progress(1.0) ? changed : -1;
 }

@@ -51,11 +51,13 @@ std::vector<std::int64_t> LabelComponents(const std::vector<std::uint8_t>& label
 // background seed) and `border` (node touches the image border) per node. Seeded nodes keep their
 // label. Returns how many node relabellings it made (a node the seeded rule drops and hole filling
 // takes back counts twice), or -1 when `progress` aborts. `objectSizes` (optional) receives the
-// sizes of the resulting object components as ObjectComponentSizes gives them, from the same pass.
+// sizes of the resulting object components as ObjectComponentSizes gives them, from the same pass,
+// and `objectComponent` (optional, with objectSizes) each node's index among them (-1 background).
 std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label, const GraphEdges& edges,
   const std::vector<std::uint8_t>& hard,
   const std::vector<std::uint8_t>& border, const ProgressFunction& progress = NoProgress(),
-  std::vector<double>* objectSizes = nullptr, const std::vector<double>& size = {});
+  std::vector<double>* objectSizes = nullptr, const std::vector<double>& size = {},
+  std::vector<std::int64_t>* objectComponent = nullptr);
 
 // The sizes of the object components (sum of `size` over their nodes, 1 per node when `size` is
 // empty), largest first; empty when `progress` aborts.

@@ -234,7 +234,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
     border[e] = 1;
   }
   result.Cut.ConnectivityChanged = ApplyConnectivity(ConnectivityFor(parameters.Connectivity, parameters.Task), result.Cut.Label, pr.Edges, pr.Hard,
-    border, NoProgress(), &result.Cut.ObjectComponentVoxels, voxelCount.Vector());
+    border, NoProgress(), &result.Cut.ObjectComponentVoxels, voxelCount.Vector(), &result.ObjectComponent);
   result.BoundaryFaces = LabelBoundaryFaces(mesh, adj, result.Cut.Label);
   return result;
 }
@@ -352,6 +352,16 @@ std::string ValidateParameters(const SeededCutParameters& p)
   if (error.empty())
   {
     error = ValidateParameters(p.Geodesic);
+  }
+  return error;
+}
+
+std::string ValidateParameters(const SuperVoxelCutParameters& p)
+{
+  std::string error = ValidateParameters(static_cast<const SeededCutParameters&>(p));
+  if (error.empty() && !(p.VoxelRefinement >= 0 && p.VoxelRefinement <= 8))
+  {
+    error = "the voxel refinement must lie in [0, 8] rings of elements.";
   }
   return error;
 }

@@ -71,6 +71,11 @@ struct SuperVoxelCutParameters : SeededCutParameters
   // latter: the elements follow the image's edges, not its contrast, and small seed elements give
   // too few samples of it.
   bool SampleSeedElements = true;
+  // Rings of elements along the cut whose voxels are labelled again by the voxel cut's energy
+  // (VoxelRefinement.h): 1 the elements with a neighbour of another label, each more ring their
+  // neighbours too; 0 off. The label image then follows the voxels where an element straddles the
+  // boundary; the elements keep their labels.
+  int VoxelRefinement = 1;
 };
 
 // Whether the histograms sample the seed elements' voxels: SampleSeedElements, not with the local contrast.
@@ -86,8 +91,9 @@ struct VoxelCutParameters : SeededCutParameters
 struct SuperVoxelCutResult
 {
   CutResult Cut;
-  // LabelBoundaryFaces of the labels.
-  std::vector<std::int64_t> BoundaryFaces;
+  // LabelBoundaryFaces of the labels, and each element's index among the object components of
+  // Cut.ObjectComponentVoxels (-1 background).
+  std::vector<std::int64_t> BoundaryFaces, ObjectComponent;
   double SetupSeconds = 0.0;
   std::string Error;
   bool Aborted = false;
@@ -183,6 +189,7 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& geometry,
 
 // Empty when usable, else a sentence.
 std::string ValidateParameters(const SeededCutParameters& p);
+std::string ValidateParameters(const SuperVoxelCutParameters& p);
 
 // f(voxel) for each voxel within `radius` (voxels, index space) of voxel v, the image's own in 2D.
 template <typename F>
