@@ -4,6 +4,7 @@
 #include "Memory.h"
 #include "MultiLabelCut.h"
 #include "SuperVoxelCut.h"
+#include "VoxelRefinement.h"
 #include "vtkFeatureMeshUtilities.h"
 
 #include "vtkCellData.h"
@@ -29,8 +30,32 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 
 vtkStandardNewMacro(vtkSuperVoxelCut);
+
+namespace
+{
+// A voxel's value, and the squared distance of two voxels' channel vectors, of an image in its own type.
+template <typename T>
+std::function<double(std::int64_t)> VoxelValue(const T* x)
+{
+  return [x](std::int64_t v) { return static_cast<double>(x[v]); };
+}
+template <typename T>
+std::function<double(std::int64_t, std::int64_t)> ChannelDistance2(const T* x, int channels)
+{
+  return [x, channels](std::int64_t a, std::int64_t b) {
+    double s = 0.0;
+    for (int c = 0; c < channels; ++c)
+    {
+      const double d = static_cast<double>(x[a * channels + c]) - static_cast<double>(x[b * channels + c]);
+      s += d * d;
+    }
+    return s;
+  };
+}
+} // namespace
 
 struct vtkSuperVoxelCut::MeshData
 {
@@ -56,9 +81,15 @@ struct vtkSuperVoxelCut::MeshData
   {
     vtkSmartPointer<vtkUnsignedCharArray> Voxels;
     std::vector<std::uint8_t> Labels;
+    // The voxels whose label the refinement set apart from their element's.
+    std::vector<std::int64_t> Refined;
   };
   std::array<LabelImage, 2> LabelImages;
   int LastLabelImage = 0;
+  // The voxel grid's automatic sigma of the values the cut reads (VoxelGridSigma; 0 until asked
+  // for), and what the voxel refinement keeps.
+  double VoxelSigma = 0.0;
+  featuremesh::VoxelRefinementCache Refinement;
 
   MeshData(std::initializer_list<vtkObject*> sources, const featuremesh::ImageGeometry& frame)
     : Frame(frame)
@@ -192,16 +223,21 @@ int vtkSuperVoxelCut::RequestData(
     MeshData& data = *this->Prepared;
     // A binary cut does not use the labelled seeds' move graphs (hundreds of MB on a brain volume).
     data.Multi.Moves.Clear();
-    const SuperVoxelCutResult result = featuremesh::SuperVoxelCut(data.Mesh, data.Cut, data.Mean, data.Count,
+    SuperVoxelCutResult result = featuremesh::SuperVoxelCut(data.Mesh, data.Cut, data.Mean, data.Count,
       objectVoxels, backgroundVoxels, voxelValue, *this, SMPParallelFor(), AlgorithmProgress(this, 0.45, 0.95), &data.Flow);
     if (result.Aborted || !result.Error.empty())
     {
       return result.Aborted ? 1 : this->Fail(result.Error);
     }
-    this->UpdateProgress(0.95);
-    const CutResult& cut = result.Cut;
-    this->WriteLabels(input, cut.Label, result.BoundaryFaces, outputVector);
+    this->UpdateProgress(0.9);
+    const VoxelRefinementResult refinement = this->RefineBinary(result, binaryValues, objectVoxels, backgroundVoxels);
+    if (refinement.Aborted || !refinement.Error.empty())
+    {
+      return refinement.Aborted ? 1 : this->Fail(refinement.Error);
+    }
+    this->WriteLabels(input, result.Cut.Label, result.BoundaryFaces, refinement, outputVector);
     this->WriteCutFields(result, geometry.VoxelVolume(), outputVector);
+    this->WriteRefinementFields(refinement, outputVector);
     this->UpdateProgress(1.0);
     return 1;
   });
@@ -349,8 +385,119 @@ int vtkSuperVoxelCut::Prepare(vtkUnstructuredGrid* input, const featuremesh::Ima
   return -1;
 }
 
+featuremesh::VoxelRefinementResult vtkSuperVoxelCut::RefineBinary(featuremesh::SuperVoxelCutResult& result,
+  vtkDataArray* values, const std::vector<std::int64_t>& objectVoxels, const std::vector<std::int64_t>& backgroundVoxels)
+{
+  using namespace featuremesh;
+  const CutResult& cut = result.Cut;
+  if (!(this->VoxelRefinement > 0) || !values)
+  {
+    return VoxelRefinementResult();
+  }
+  std::vector<std::int64_t> seedVoxels = objectVoxels;
+  seedVoxels.insert(seedVoxels.end(), backgroundVoxels.begin(), backgroundVoxels.end());
+  const bool spatial = !cut.SpatialObject.empty();
+  const double lambda = this->Lambda;
+  std::function<double(std::int64_t)> value;
+  switch (values->GetDataType())
+  {
+    vtkTemplateMacro(value = VoxelValue(static_cast<const VTK_TT*>(values->GetVoidPointer(0))));
+  }
+  VoxelRefinementResult refinement = this->Refine(cut.Label, 2, values, seedVoxels,
+    [&](std::int64_t v, std::int64_t e, double* costs) {
+      const int b = cut.ValueBin(value(v));
+      costs[0] = lambda * (cut.BinCostBackground[b] + (spatial ? cut.SpatialBackground[e] : 0.0));
+      costs[1] = lambda * (cut.BinCostObject[b] + (spatial ? cut.SpatialObject[e] : 0.0));
+    },
+    &result.ObjectComponent, 0.9);
+  // The components' volumes hold the refined voxels too.
+  std::vector<double>& volumes = result.Cut.ObjectComponentVoxels;
+  for (std::size_t c = 0; c < refinement.ComponentChange.size() && c < volumes.size(); ++c)
+  {
+    volumes[c] += refinement.ComponentChange[c];
+  }
+  std::stable_sort(volumes.begin(), volumes.end(), std::greater<double>());
+  return refinement;
+}
+
+featuremesh::VoxelRefinementResult vtkSuperVoxelCut::RefineLabels(
+  const featuremesh::MultiLabelResult& result, vtkDataArray* values, const featuremesh::LabelledSeeds& seeds)
+{
+  using namespace featuremesh;
+  if (!(this->VoxelRefinement > 0))
+  {
+    return VoxelRefinementResult();
+  }
+  const MeshData& data = *this->Prepared;
+  const int L = result.Labels;
+  const double lambda = this->Lambda;
+  const std::vector<std::vector<double>>& binCosts = result.BinCosts;
+  const std::vector<std::uint16_t>& bin = data.Bins.Bin;
+  const std::vector<double>& size = data.ChannelCount;
+  const SharedArray<double>& spatial = result.Spatial;
+  return this->Refine(result.Label, L, values, seeds.Voxel,
+    [&](std::int64_t v, std::int64_t e, double* costs) {
+      for (int l = 0; l < L; ++l)
+      {
+        costs[l] = lambda * binCosts[l][bin[v]] + (spatial.empty() || !(size[e] > 0.0) ? 0.0 : spatial[e * L + l] / size[e]);
+      }
+    },
+    nullptr, 0.9);
+}
+
+featuremesh::VoxelRefinementResult vtkSuperVoxelCut::Refine(const std::vector<std::uint8_t>& labels, int labelCount,
+  vtkDataArray* values, const std::vector<std::int64_t>& seedVoxels,
+  const std::function<void(std::int64_t, std::int64_t, double*)>& cost, const std::vector<std::int64_t>* component,
+  double progressFrom)
+{
+  using namespace featuremesh;
+  MeshData& data = *this->Prepared;
+  const int channels = values->GetNumberOfComponents();
+  VoxelRefinementProblem p;
+  p.Mesh = &data.Mesh;
+  p.Owner = &data.Cut.Owner;
+  p.Label = &labels;
+  p.Labels = labelCount;
+  const SuperVoxelCutParameters& par = *this;
+  p.Rings = par.VoxelRefinement;
+  p.Connectivity = ConnectivityFor(par.Connectivity, par.Task);
+  p.Fixed.assign(labels.size(), 0);
+  for (std::int64_t v : seedVoxels)
+  {
+    if (data.Cut.Owner[v] >= 0)
+    {
+      p.Fixed[data.Cut.Owner[v]] = 1;
+    }
+  }
+  p.Cost = cost;
+  p.Component = component;
+  p.Parallel = SMPParallelFor();
+  switch (values->GetDataType())
+  {
+    vtkTemplateMacro(p.Distance2 = ChannelDistance2(static_cast<const VTK_TT*>(values->GetVoidPointer(0)), channels);
+                     if (!(data.VoxelSigma > 0.0)) {
+                       data.VoxelSigma = VoxelGridSigma(
+                         static_cast<const VTK_TT*>(values->GetVoidPointer(0)), channels, data.Mesh.Geometry(), p.Parallel);
+                     });
+  }
+  p.Sigma = this->Sigma > 0.0 ? this->Sigma : data.VoxelSigma;
+  return RefineOnVoxels(p, AlgorithmProgress(this, progressFrom, 1.0), &data.Refinement);
+}
+
+void vtkSuperVoxelCut::WriteRefinementFields(const featuremesh::VoxelRefinementResult& refinement, vtkInformationVector* outputVector)
+{
+  using namespace featuremesh;
+  for (vtkDataObject* d : { vtkDataObject::GetData(outputVector, 0), vtkDataObject::GetData(outputVector, 2) })
+  {
+    AddFieldValues(d, { { names::RefinedVoxels, static_cast<double>(refinement.BandVoxels) },
+                        { names::RelabelledVoxels, static_cast<double>(refinement.Voxel.size()) },
+                        { names::VoxelRefinementSeconds, refinement.Seconds } });
+  }
+}
+
 void vtkSuperVoxelCut::WriteLabels(vtkUnstructuredGrid* input, const std::vector<std::uint8_t>& labels,
-  const std::vector<std::int64_t>& boundaryFaces, vtkInformationVector* outputVector)
+  const std::vector<std::int64_t>& boundaryFaces, const featuremesh::VoxelRefinementResult& refinement,
+  vtkInformationVector* outputVector)
 {
   using namespace featuremesh;
   MeshData& data = *this->Prepared;
@@ -375,7 +522,7 @@ void vtkSuperVoxelCut::WriteLabels(vtkUnstructuredGrid* input, const std::vector
   labelImage->GetFieldData()->Initialize();
   vtkPolyData::GetData(outputVector, 1)->GetFieldData()->Initialize();
   SetImageFrame(labelImage, geometry);
-  labelImage->GetPointData()->SetScalars(this->LabelVoxels(labels));
+  labelImage->GetPointData()->SetScalars(this->LabelVoxels(labels, refinement));
   if (this->SuperVoxelIds)
   {
     vtkNew<vtkIdTypeArray> ids;
@@ -386,7 +533,8 @@ void vtkSuperVoxelCut::WriteLabels(vtkUnstructuredGrid* input, const std::vector
   }
 }
 
-vtkUnsignedCharArray* vtkSuperVoxelCut::LabelVoxels(const std::vector<std::uint8_t>& labels)
+vtkUnsignedCharArray* vtkSuperVoxelCut::LabelVoxels(
+  const std::vector<std::uint8_t>& labels, const featuremesh::VoxelRefinementResult& refinement)
 {
   using namespace featuremesh;
   MeshData& data = *this->Prepared;
@@ -414,13 +562,27 @@ vtkUnsignedCharArray* vtkSuperVoxelCut::LabelVoxels(const std::vector<std::uint8
     {
       std::copy_n(held.Voxels->GetPointer(0), size, fresh.Voxels->GetPointer(0));
       fresh.Labels = held.Labels;
+      fresh.Refined = held.Refined;
     }
   }
   MeshData::LabelImage& image = data.LabelImages[slot];
+  // The last refinement undone first: the image then holds its elements' labels, as a patch needs.
+  std::uint8_t* voxels = image.Voxels->GetPointer(0);
+  if (!image.Labels.empty())
+  {
+    for (std::int64_t v : image.Refined)
+    {
+      const std::int32_t e = data.Cut.Owner[v];
+      voxels[v] = e >= 0 && e < static_cast<std::int64_t>(image.Labels.size()) ? image.Labels[e] : 0;
+    }
+  }
+  image.Refined.clear();
   if (!PatchVoxelLabels(data.Mesh, data.Cut.Owner, image.Labels, labels, image.Voxels->GetPointer(0), SMPParallelFor()))
   {
     VoxelLabels(data.Cut.Owner, labels, image.Voxels->GetPointer(0), SMPParallelFor());
   }
+  ApplyRefinement(refinement, voxels);
+  image.Refined = refinement.Voxel;
   // Written through its pointer: without Modified a kept image's cached value range (VTK's, which
   // ParaView shows) would stay the cut's before last.
   image.Voxels->Modified();
@@ -481,7 +643,13 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
   {
     return result.Aborted ? 1 : this->Fail(result.Error);
   }
-  this->WriteLabels(input, result.Label, result.BoundaryFaces, outputVector);
+  const VoxelRefinementResult refinement = this->RefineLabels(result, values, seeds);
+  if (refinement.Aborted || !refinement.Error.empty())
+  {
+    return refinement.Aborted ? 1 : this->Fail(refinement.Error);
+  }
+  this->WriteLabels(input, result.Label, result.BoundaryFaces, refinement, outputVector);
+  this->WriteRefinementFields(refinement, outputVector);
   for (vtkDataObject* d : { vtkDataObject::GetData(outputVector, 0), vtkDataObject::GetData(outputVector, 2) })
   {
     AddMultiLabelFields(d, result, this->LabelNames);
@@ -514,6 +682,7 @@ void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
      << indent << "ScaleByContact: " << this->ScaleByContact << "\n"
      << indent << "VoxelRegionTerm: " << this->VoxelRegionTerm << "\n"
      << indent << "SampleSeedElements: " << this->SampleSeedElements << "\n"
+     << indent << "VoxelRefinement: " << this->VoxelRefinement << "\n"
      << indent << "SeedRadius: " << this->SeedRadius << "\n"
      << indent << "SeedLabelArray: " << this->SeedLabelArray << "\n"
      << indent << "ChannelModel: " << this->GetChannelModel() << "\n"

@@ -12,7 +12,8 @@
  * (labelled seeds instead of ports 1 and 2: k objects by alpha-expansion, featuremesh::MultiLabelCut). A seed belongs to
  * the element that owns the voxel containing it. Outputs: 0 the mesh with cell array `Label`
  * (1 object, 0 background); 1 the boundary between labels (2D polylines, 3D a closed outward
- * triangle surface on the mesh's points); 2 the labels rasterised on the image grid (uint8).
+ * triangle surface on the mesh's points); 2 the labels rasterised on the image grid (uint8), the
+ * voxels of the elements along the cut labelled again by the voxel cut's energy (VoxelRefinement).
  */
 #ifndef vtkSuperVoxelCut_h
 #define vtkSuperVoxelCut_h
@@ -22,9 +23,11 @@
 #include "vtkFeatureMeshFilter.h" // the shared run and start-up
 #include "MultiLabelCut.h" // the parameters, declared once
 #include "SuperVoxelCut.h"
+#include "VoxelRefinement.h"
 #include "vtkUnstructuredGridAlgorithm.h"
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -104,6 +107,12 @@ public:
   vtkSetMacro(SuperVoxelIds, bool);
   vtkGetMacro(SuperVoxelIds, bool);
   vtkBooleanMacro(SuperVoxelIds, bool);
+  /// With the Image connected: rings of elements along the cut whose voxels are labelled again by
+  /// the voxel cut's energy (default 1: the elements with a neighbour of another label; 0 off). The
+  /// label image then follows the voxels where an element straddles the boundary; the mesh's
+  /// elements keep their labels. Beyond [0, 8]: an error at execution.
+  vtkSetMacro(VoxelRefinement, int);
+  vtkGetMacro(VoxelRefinement, int);
   /// Radius (voxels) of each seed's neighbourhood when SampleSeedElements is off.
   vtkSetMacro(SeedRadius, double);
   vtkGetMacro(SeedRadius, double);
@@ -136,9 +145,24 @@ protected:
 private:
   // The three outputs from the elements' labels and the boundary faces between them.
   void WriteLabels(vtkUnstructuredGrid* input, const std::vector<std::uint8_t>& labels,
-    const std::vector<std::int64_t>& boundaryFaces, vtkInformationVector* outputVector);
-  // Output 2's voxel labels, in an array the filter keeps for the next cut.
-  vtkUnsignedCharArray* LabelVoxels(const std::vector<std::uint8_t>& labels);
+    const std::vector<std::int64_t>& boundaryFaces, const featuremesh::VoxelRefinementResult& refinement,
+    vtkInformationVector* outputVector);
+  // Output 2's voxel labels with the refinement's, in an array the filter keeps for the next cut.
+  vtkUnsignedCharArray* LabelVoxels(const std::vector<std::uint8_t>& labels, const featuremesh::VoxelRefinementResult& refinement);
+  // The binary cut's voxel refinement (none when VoxelRefinement is 0 or without the image's
+  // values), its object components' volumes updated; the labelled seeds' cut's.
+  featuremesh::VoxelRefinementResult RefineBinary(featuremesh::SuperVoxelCutResult& result, vtkDataArray* values,
+    const std::vector<std::int64_t>& objectVoxels, const std::vector<std::int64_t>& backgroundVoxels);
+  featuremesh::VoxelRefinementResult RefineLabels(
+    const featuremesh::MultiLabelResult& result, vtkDataArray* values, const featuremesh::LabelledSeeds& seeds);
+  // The voxels along the cut labelled again (VoxelRefinement.h) from the cut's terms per voxel:
+  // `cost(v, e, costs)` before the Potts weights of `values`; the seeds' elements keep their labels.
+  // With `component` (binary) the result gives each object component's change in voxels.
+  featuremesh::VoxelRefinementResult Refine(const std::vector<std::uint8_t>& labels, int labelCount, vtkDataArray* values,
+    const std::vector<std::int64_t>& seedVoxels, const std::function<void(std::int64_t, std::int64_t, double*)>& cost,
+    const std::vector<std::int64_t>* component, double progressFrom);
+  // The refinement's field data on the labelled mesh and the label image.
+  void WriteRefinementFields(const featuremesh::VoxelRefinementResult& refinement, vtkInformationVector* outputVector);
   // The image frame (the Image input, else the mesh's field data) and the values the cut reads:
   // -1 to go on, else RequestData's result. `binaryValues` is `valuesArray` when it has one
   // component; several serve labelled seeds only.

@@ -3,7 +3,7 @@ wrong, as in the standard protocol of interactive segmentation (NoC@85 / NoC@90:
 interactive object selection", CVPR 2016).
 
 usage: pvpython scripts/benchmark_clicks.py [--rounds 10] [--cases a,b] [--methods supervoxel,voxel,random_walker,watershed]
-                                            [--out out/benchmark_clicks]
+                                            [--cut VoxelRefinement=0] [--out out/benchmark_clicks]
 Each case starts from its seed files and runs with its task (cases.csv). Each round: the largest
 connected error region of the current result (face-connected; false positives and false negatives
 apart), one seed at its most interior voxel (largest distance to the region's border, in world
@@ -57,7 +57,7 @@ def next_seed(result, truth, spacing):
 class Loop:
     """One method's segmentation from (object, background) seed index lists ((i, j, k) each)."""
 
-    def __init__(self, method, case, image):
+    def __init__(self, method, case, image, cut=None):
         self.method, self.case = method, case
         self.origin, self.spacing = np.array(image.GetOrigin()), np.array(image.GetSpacing())
         self.shape = image.GetDimensions()[::-1]
@@ -68,7 +68,7 @@ class Loop:
                 mesh = case.smoothing(case.mesh(case.feature_nodes()))
                 mesh.UpdatePipeline()
                 self.proxy = ps.SuperVoxelCut(Mesh=mesh, ObjectSeeds=self.object, BackgroundSeeds=self.background,
-                                              Image=case.image, Scalars=case.scalars, **case.with_task({}))
+                                              Image=case.image, Scalars=case.scalars, **case.with_task(dict(cut or {})))
             else:
                 self.proxy = ps.VoxelCut(Input=case.image, ObjectSeeds=self.object, BackgroundSeeds=self.background,
                                          Scalars=case.scalars, **case.with_task({}))
@@ -102,7 +102,7 @@ def noc(dices, target, rounds):
     return hit[0] if hit else rounds + 1
 
 
-def run(case, method, rounds):
+def run(case, method, rounds, cut=None):
     image = fm.fetch(case.image)
     truth = case.truth().reshape(image.GetDimensions()[::-1]).astype(bool)
     origin, spacing = np.array(image.GetOrigin()), np.array(image.GetSpacing())
@@ -111,7 +111,7 @@ def run(case, method, rounds):
         pts = np.loadtxt(os.path.join(case.folder, name), delimiter=",", skiprows=1, ndmin=2)
         seeds.append([tuple(int(v) for v in s) for s in np.rint((pts - origin) / spacing)])
     object_seeds, background_seeds = seeds
-    loop = Loop(method, case, image)
+    loop = Loop(method, case, image, cut)
     dices, seconds, lost, added = [], [], 0, []
     for r in range(rounds + 1):
         mask, t = loop.segment(object_seeds, background_seeds)
@@ -141,6 +141,8 @@ def main():
     ap.add_argument("--rounds", type=int, default=10)
     ap.add_argument("--cases", default="")
     ap.add_argument("--methods", default=",".join(METHODS))
+    ap.add_argument("--cut", default="", type=fm.parse_properties,
+                    help="properties of the Super-Voxel Cut, e.g. VoxelRefinement=0")
     ap.add_argument("--out", default=os.path.join(fm.ROOT, "out", "benchmark_clicks"))
     args = ap.parse_args()
     methods = [m for m in args.methods.split(",") if m]
@@ -157,7 +159,7 @@ def main():
             print("%s: no truth.mha, skipped" % name)
             continue
         for method in methods:
-            row = run(case, method, args.rounds)
+            row = run(case, method, args.rounds, args.cut if method == "supervoxel" else None)
             rows.append(row)
             print("%s %s (%s): Dice %s, NoC@85 %d, NoC@90 %d, round %.3f s, lost seeds %d" % (
                 name, method, row["task"], " ".join("%.3f" % d for d in row["dice"]), row["noc85"], row["noc90"],

@@ -1,6 +1,6 @@
 """The kept re-cut (pvpython): what one seed edit costs once the mesh is made, as the GUI pays it.
 
-usage: pvpython scripts/benchmark_recut.py [--edits 10] [--cases a,b] [--out out/benchmark_recut]
+usage: pvpython scripts/benchmark_recut.py [--edits 10] [--cases a,b] [--cut VoxelRefinement=0] [--out out/benchmark_recut]
 Each case (the binary cases with their task from cases.csv, then the multi-label cases) runs
 stages 1 -> 2 -> 3 and the Super-Voxel Cut once. Then the robot user's first seed (the most
 interior voxel of the largest error region, with the truth's label, as benchmark_clicks.py and
@@ -8,7 +8,8 @@ benchmark_multilabel.py place it) is added and removed again, --edits times each
 image held each time as a view holds it (the cut cannot rewrite it in place). One sample of a re-cut
 is noisy on a shared VM; the medians of many are not. Per case and edit: the median and the smallest
 of the cut's own seconds (its field data's CutTotalSeconds), and the medians of its parts:
-SetupSeconds, GeodesicSeconds, and FlowSeconds (one object) or ExpansionSeconds (labels).
+SetupSeconds, GeodesicSeconds, FlowSeconds (one object) or ExpansionSeconds (labels), and
+VoxelRefinementSeconds. --cut sets properties of the cut (as benchmark_multilabel.py's).
 Without --cases: the binary object cases and the multi-label cases. Writes OUT.md and OUT.csv.
 """
 import argparse
@@ -24,7 +25,7 @@ import featuremesh as fm
 from featuremesh import report
 from benchmark_multilabel import field, robot_seed, write_seeds
 
-PARTS = ("CutTotalSeconds", "SetupSeconds", "GeodesicSeconds", "FlowSeconds", "ExpansionSeconds")
+PARTS = ("CutTotalSeconds", "SetupSeconds", "GeodesicSeconds", "FlowSeconds", "ExpansionSeconds", "VoxelRefinementSeconds")
 
 
 def delete_all():
@@ -68,7 +69,7 @@ def binary_case(name, folder, args):
         Points=points(rows["background"]))
     mesh = case.smoothing(case.mesh(case.feature_nodes()))
     cut = ps.SuperVoxelCut(Mesh=mesh, ObjectSeeds=object_source, BackgroundSeeds=background_source, Image=case.image,
-                           Scalars=case.scalars, **case.with_task({}))
+                           Scalars=case.scalars, **case.with_task(dict(args.cut)))
     cut.UpdatePipeline()
     found = robot_seed(fm.labels(cut), truth, shape, spacing)
     if found is None:
@@ -96,7 +97,7 @@ def multilabel_case(name, folder, args, tmp):
     truth = case.truth()
     rows = list(case.seed_rows())
     mesh = case.mesh()
-    cut = case.super_voxel_cut(mesh)
+    cut = case.super_voxel_cut(mesh, **args.cut)
     cut.UpdatePipeline()
     found = robot_seed(fm.labels(cut), truth, shape, spacing)
     if found is None:
@@ -123,6 +124,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--edits", type=int, default=10)
     ap.add_argument("--cases", default="")
+    ap.add_argument("--cut", default="", type=fm.parse_properties, help="properties of the cut, e.g. VoxelRefinement=0")
     ap.add_argument("--out", default=os.path.join(fm.ROOT, "out", "benchmark_recut"))
     args = ap.parse_args()
     fm.load_plugin()
@@ -142,7 +144,8 @@ def main():
     lines = ["# The kept re-cut", "", report.machine(), "",
              "The robot's first seed added and removed %d times each, the label image held; seconds of the cut "
              "(median, smallest in brackets) and the medians of its parts." % args.edits, "",
-             "| case | labels | elements | seed | edit | cut | setup | geodesic | flow / expansion |", "|---" * 9 + "|"]
+             "| case | labels | elements | seed | edit | cut | setup | geodesic | flow / expansion | voxel refinement |",
+             "|---" * 10 + "|"]
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     with open(args.out + ".csv", "w", newline="") as f:
         w = csv.writer(f)
@@ -153,9 +156,10 @@ def main():
                 for p, v in parts.items():
                     w.writerow([r["case"], r["labels"], r["elements"], r["seed"], edit, p, "%.4f" % med[p], "%.4f" % min(v)])
                 solve = med["FlowSeconds"] if r["labels"] == 2 else med["ExpansionSeconds"]
-                lines.append("| %s | %d | %d | %s | %s | %.3f (%.3f) | %.3f | %.3f | %.3f |" % (
+                lines.append("| %s | %d | %d | %s | %s | %.3f (%.3f) | %.3f | %.3f | %.3f | %.3f |" % (
                     r["case"], r["labels"], r["elements"], r["seed"], edit, med["CutTotalSeconds"],
-                    min(parts["CutTotalSeconds"]), med["SetupSeconds"], med["GeodesicSeconds"], solve))
+                    min(parts["CutTotalSeconds"]), med["SetupSeconds"], med["GeodesicSeconds"], solve,
+                    med["VoxelRefinementSeconds"]))
     with open(args.out + ".md", "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))

@@ -43,6 +43,10 @@ def cell_array(data, names):
     raise KeyError(names)
 
 
+# Properties the Super-Voxel Cut has and the Voxel Cut has not: --cut passes them to the first only.
+SUPER_VOXEL_ONLY = ("VoxelRefinement", "ScaleByContact", "VoxelRegionTerm", "SampleSeedElements", "SuperVoxelIds")
+
+
 def owners(proxy):
     """The voxel -> element map a mesh proxy keeps (fm.owner_map), or "none"."""
     a = fm.owner_map(proxy)
@@ -116,7 +120,8 @@ def main():
                 lines.append("%s smoothed %s" % (tag, sha(fm.v2n(s.GetPoints().GetData()), ids(fm.v2n(s.GetCells().GetConnectivityArray())),
                                                           *[cell_array(s, a) for a in CELL_ARRAYS])))
                 lines.append("%s smoothed owners %s" % (tag, owners(smoothed)))
-        lines.append("%s voxelcut %s" % (name, sha(fm.v2n(fm.fetch(case.voxel_cut(**cut_properties)).GetPointData().GetScalars()))))
+        voxel_properties = {k: v for k, v in cut_properties.items() if k not in SUPER_VOXEL_ONLY}
+        lines.append("%s voxelcut %s" % (name, sha(fm.v2n(fm.fetch(case.voxel_cut(**voxel_properties)).GetPointData().GetScalars()))))
         rsp = case.rsp()
         r, contour = fm.fetch(rsp, 0), fm.fetch(rsp, 1)
         seeded = fm.fetch(case.feature_nodes(edges=rsp))

@@ -130,6 +130,11 @@ constexpr const char* SetupSeconds = "SetupSeconds";
 constexpr const char* GraphSeconds = "GraphSeconds";
 constexpr const char* FlowSeconds = "FlowSeconds";
 constexpr const char* GeodesicSeconds = "GeodesicSeconds"; // the seeds' spatial term (Task Object)
+// The voxel refinement along the cut: the voxels labelled again, those whose label then differs
+// from their element's, and its time.
+constexpr const char* RefinedVoxels = "RefinedVoxels";
+constexpr const char* RelabelledVoxels = "RelabelledVoxels";
+constexpr const char* VoxelRefinementSeconds = "VoxelRefinementSeconds";
 // Multi-label cuts (labelled seeds): the number of labels k + 1 and their names (string array, one
 // per label, empty names when none were given), the Potts energy reached, the expansion moves that
 // lowered it, the cycles over the labels, the alpha-expansion's time.

@@ -953,6 +953,22 @@ TEST(SuperVoxelCut, SeedRadiusOutOfRange)
       f->SetSeedRadius(-1);
     });
 }
+TEST(SuperVoxelCut, VoxelRefinementOutOfRange)
+{
+  Case2D c;
+  for (const int rings : { -1, 9 })
+    SuperVoxelCut(c.mesh, c.object, c.background, c.image,
+      [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "voxel refinement"); },
+      [rings](vtkSuperVoxelCut* f) { f->SetVoxelRefinement(rings); });
+}
+TEST(SuperVoxelCut, VoxelRefinementOverEveryElement)
+{
+  // Eight rings reach every element of the small mesh: a good cut whose seeds keep their labels.
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image,
+    [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, c.image, c.object, c.background); },
+    [](vtkSuperVoxelCut* f) { f->SetVoxelRefinement(8); });
+}
 TEST(SuperVoxelCut, TaskOutOfRange)
 {
   Case2D c;

@@ -98,6 +98,7 @@ int main(int argc, char* argv[])
     GETTER(vtkSuperVoxelCut, ScaleByContact), GETTER(vtkSuperVoxelCut, VoxelRegionTerm),
     GETTER(vtkSuperVoxelCut, Connectivity), GETTER(vtkSuperVoxelCut, Bandwidth),
     GETTER(vtkSuperVoxelCut, SampleSeedElements), GETTER(vtkSuperVoxelCut, SeedRadius),
+    GETTER(vtkSuperVoxelCut, VoxelRefinement),
     GETTER(vtkSuperVoxelCut, SuperVoxelIds), GETTER(vtkSuperVoxelCut, Task),
     GETTER(vtkSuperVoxelCut, GeodesicWeight), GETTER(vtkSuperVoxelCut, GeodesicLength),
     GETTER(vtkSuperVoxelCut, Intensity), GETTER(vtkSuperVoxelCut, ContrastScale),

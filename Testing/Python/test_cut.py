@@ -37,9 +37,14 @@ def run(case):
     return d, image, truth, so, sb, cut
 
 
+def digests(cut):
+    """The elements' labels and the label image (refined along the cut), as one string."""
+    return ft.digest(ft.array(ft.fetch(cut), ft.names.Label, cells=True)) + " " + ft.digest(ft.array(ft.fetch(cut, 2)))
+
+
 if len(sys.argv) > 1:  # child run for the thread-count check
     *_, cut = run(sys.argv[1])
-    print(ft.digest(ft.array(ft.fetch(cut), ft.names.Label, cells=True)))
+    print(digests(cut))
     sys.exit(0)
 
 for case, (svc_floor, voxel_floor) in FLOORS.items():
@@ -96,12 +101,12 @@ for case, (svc_floor, voxel_floor) in FLOORS.items():
         Ps = ft.v2n(surface.GetPoints().GetData())
         enclosed = np.einsum("ij,ij->i", Ps[F[:, 0]], np.cross(Ps[F[:, 1]], Ps[F[:, 2]])).sum() / 6
         ft.check(abs(enclosed - tet) <= 1e-6 * tet, "%s: surface encloses the object elements' volume (rel. err %.1e)" % (case, abs(enclosed - tet) / tet))
-    digest = ft.digest(label)
+    digest = digests(cut)
     *_, again = run(case)
-    ft.check(ft.digest(ft.array(ft.fetch(again), ft.names.Label, cells=True)) == digest, "%s: identical labels across runs" % case)
+    ft.check(digests(again) == digest, "%s: identical labels and label image across runs" % case)
     one = ft.run_script_with_backend(__file__, "Sequential", case)
     two = ft.run_script_with_backend(__file__, "STDThread", case)
-    ft.check(one == two == digest, "%s: identical labels with 1 and 2 threads" % case)
+    ft.check(one == two == digest, "%s: identical labels and label image with 1 and 2 threads" % case)
 
 # The cut keeps what depends on the mesh alone between runs: after a seed edit, and after the mesh
 # changes, it gives what a fresh filter gives.
