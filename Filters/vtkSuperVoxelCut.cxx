@@ -224,7 +224,7 @@ int vtkSuperVoxelCut::RequestData(
     // A binary cut does not use the labelled seeds' move graphs (hundreds of MB on a brain volume).
     data.Multi.Moves.Clear();
     SuperVoxelCutResult result = featuremesh::SuperVoxelCut(data.Mesh, data.Cut, data.Mean, data.Count,
-      objectVoxels, backgroundVoxels, voxelValue, *this, SMPParallelFor(), AlgorithmProgress(this, 0.45, 0.95), &data.Flow);
+      objectVoxels, backgroundVoxels, voxelValue, *this, SMPParallelFor(), AlgorithmProgress(this, 0.45, 0.9), &data.Flow);
     if (result.Aborted || !result.Error.empty())
     {
       return result.Aborted ? 1 : this->Fail(result.Error);
@@ -638,7 +638,7 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
   this->UpdateProgress(0.45);
   const MultiLabelParameters& multi = *this;
   const MultiLabelResult result = MultiLabelSuperVoxelCut(mesh, data.Cut, data.Bins, data.Runs, data.ChannelMean,
-    data.ChannelCount, seeds, par, multi, parallel, AlgorithmProgress(this, 0.45, 0.95), &data.Multi);
+    data.ChannelCount, seeds, par, multi, parallel, AlgorithmProgress(this, 0.45, 0.9), &data.Multi);
   if (result.Aborted || !result.Error.empty())
   {
     return result.Aborted ? 1 : this->Fail(result.Error);

@@ -585,8 +585,8 @@ public:
       this->Start[b] = value(lo);
     }
   }
-  // Clamped before the conversion: a value far beyond the range (an outlier a billion bins away)
-  // must not overflow the int, which would put it in bin 0 and stall the runs above.
+  // ValueBins' rule: an outlier far beyond the range must not overflow the int, which would put it
+  // in bin 0 and stall the runs above.
   int operator()(double v) const { return ValueBins{ this->Count, this->Low, this->Width }(v); }
   // The smallest value of bin b (b in [0, Size()]; -inf and +inf at the ends).
   double First(int b) const { return this->Start[b]; }
