@@ -1,7 +1,6 @@
 #include "AlphaExpansion.h"
+#include "FlowGraph.h"
 #include "Memory.h"
-
-#include <maxflow.h>
 
 #include <algorithm>
 #include <cmath>
@@ -12,13 +11,7 @@ namespace featuremesh
 {
 namespace
 {
-using Flow = maxflow::Graph_DDD;
-
-// libmaxflow calls this before exit(1) when an allocation fails: throwing keeps the host alive.
-void ThrowOutOfMemory(const char* what)
-{
-  throw std::runtime_error(std::string("max-flow: ") + what);
-}
+using Flow = FlowGraph;
 
 // Loops over fixed blocks of nodes (or of the edges' blocks), so that a sum adds its blocks' partial
 // sums in block order and comes out the same for any thread count.

@@ -1,8 +1,7 @@
 #include "BoykovJolly.h"
+#include "FlowGraph.h"
 #include "Memory.h"
 #include "Percentile.h"
-
-#include <maxflow.h>
 
 #include <algorithm>
 #include <array>
@@ -414,19 +413,13 @@ FEATUREMESH_GROUP_VOXEL_VALUES(unsigned long long)
 
 namespace
 {
-// libmaxflow calls this before exit(1) when an allocation fails: throwing keeps the host alive.
-void ThrowOutOfMemory(const char* what)
-{
-  throw std::runtime_error(std::string("max-flow: ") + what);
-}
-
 // Long loops ask for progress (and abort) every 2^18 steps: a few ms each, ~0.25 s at the worst
 // on fresh memory.
 constexpr std::int64_t CheckEvery = (std::int64_t(1) << 18) - 1;
 
 } // namespace
 
-using Flow = maxflow::Graph_DDD;
+using Flow = FlowGraph;
 
 // The graph after its last max-flow, and what it was built from.
 struct MaxFlowCache::Kept

@@ -1,7 +1,6 @@
 #include "VoxelRefinement.h"
+#include "FlowGraph.h"
 #include "Memory.h"
-
-#include <maxflow.h>
 
 #include <algorithm>
 #include <array>
@@ -16,13 +15,7 @@ namespace featuremesh
 namespace
 {
 using Clock = std::chrono::steady_clock;
-using Flow = maxflow::Graph_DDD;
-
-// libmaxflow calls this before exit(1) when an allocation fails: throwing keeps the host alive.
-void ThrowOutOfMemory(const char* what)
-{
-  throw std::runtime_error(std::string("max-flow: ") + what);
-}
+using Flow = FlowGraph;
 
 // The exact minimum of a two-label Potts problem (label 1 on the source side) on `g`, emptied
 // first; returns the energy.
@@ -468,30 +461,46 @@ void LoneVoxelsAround(const Band& band, const std::vector<std::uint8_t>& x, std:
 }
 // Each component's change in voxels: a voxel of an object element with its element's component, a
 // voxel of a background element with that of the object element fewest face steps away (the band
-// lies within Rings steps of one; a lone voxel one more).
-std::vector<double> ComponentChanges(const VoxelRefinementProblem& p, const VoxelRefinementResult& r)
+// lies within Rings steps of one; a lone voxel one more). A shortest such path runs through band or
+// seed elements only, so only their faces are walked, in the mesh's face order (its ties too).
+std::vector<double> ComponentChanges(const VoxelRefinementProblem& p, const VoxelRefinementResult& r,
+  const std::vector<std::uint8_t>& bandElement)
 {
   const std::vector<std::int64_t>& component = *p.Component;
   const std::vector<std::uint8_t>& label = *p.Label;
   std::vector<double> change(1 + *std::max_element(component.begin(), component.end()), 0.0);
-  std::vector<std::int64_t> nearest = component;
   const FaceAdjacency& faces = *p.Mesh->SharedFaces();
+  const auto inside = [&](std::int64_t e) { return bandElement[e] || (!p.Fixed.empty() && p.Fixed[e]); };
+  std::vector<std::int64_t> local;
+  for (std::size_t f = 0; f < faces.A.size(); ++f)
+  {
+    if (inside(faces.A[f]) || inside(faces.B[f]))
+    {
+      local.push_back(static_cast<std::int64_t>(f));
+    }
+  }
+  std::vector<std::int64_t> nearest = component;
+  std::vector<std::pair<std::int64_t, std::int64_t>> set;
   for (int step = 0; step <= p.Rings; ++step)
   {
-    std::vector<std::int64_t> grown = nearest;
-    for (std::size_t f = 0; f < faces.A.size(); ++f)
+    set.clear();
+    for (std::int64_t f : local)
     {
       const std::int64_t a = faces.A[f], b = faces.B[f];
-      if (grown[a] < 0 && nearest[b] >= 0)
+      if (nearest[a] < 0 && nearest[b] >= 0)
       {
-        grown[a] = nearest[b];
+        set.emplace_back(a, nearest[b]);
       }
-      if (grown[b] < 0 && nearest[a] >= 0)
+      if (nearest[b] < 0 && nearest[a] >= 0)
       {
-        grown[b] = nearest[a];
+        set.emplace_back(b, nearest[a]);
       }
     }
-    nearest.swap(grown);
+    // The first face in order that reaches an element gives it its component.
+    for (auto it = set.rbegin(); it != set.rend(); ++it)
+    {
+      nearest[it->first] = it->second;
+    }
   }
   for (std::size_t k = 0; k < r.Voxel.size(); ++k)
   {
@@ -619,7 +628,7 @@ VoxelRefinementResult RefineOnVoxels(const VoxelRefinementProblem& p, const Prog
   r.Label.insert(r.Label.end(), loneLabel.begin(), loneLabel.end());
   if (p.Component && p.Labels == 2 && p.Component->size() == p.Label->size() && !p.Component->empty())
   {
-    r.ComponentChange = ComponentChanges(p, r);
+    r.ComponentChange = ComponentChanges(p, r, bandElement);
   }
   r.Seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return r;
