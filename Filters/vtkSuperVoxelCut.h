@@ -108,9 +108,9 @@ public:
   vtkGetMacro(SuperVoxelIds, bool);
   vtkBooleanMacro(SuperVoxelIds, bool);
   /// With the Image connected: rings of elements along the cut whose voxels are labelled again by
-  /// the voxel cut's energy (default 1: the elements with a neighbour of another label; 0 off). The
-  /// label image then follows the voxels where an element straddles the boundary; the mesh's
-  /// elements keep their labels. Beyond [0, 8]: an error at execution.
+  /// the voxel cut's energy (1: the elements with a neighbour of another label; default 2: their
+  /// neighbours too; 0 off). The label image then follows the voxels where an element straddles
+  /// the boundary; the mesh's elements keep their labels. Beyond [0, 8]: an error at execution.
   vtkSetMacro(VoxelRefinement, int);
   vtkGetMacro(VoxelRefinement, int);
   /// Radius (voxels) of each seed's neighbourhood when SampleSeedElements is off.
