@@ -272,6 +272,48 @@ TEST(AlphaExpansion, RecycledMovesEqualFreshMoves)
     }
 }
 
+TEST(AlphaExpansion, AWorkspaceLentAcrossProblemsChangesNothing)
+{
+  // One workspace lent to expansions of different graphs, sizes and label counts (larger, then
+  // smaller, then larger again, as the voxel refinement's bands come): each gives a fresh
+  // expansion's labels and energy.
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<std::int64_t> a, b;
+  for (int e = 0; e < 1500; ++e)
+  {
+    const std::int64_t p = rng() % 400, q = rng() % 400;
+    if (p != q)
+    {
+      a.push_back(p);
+      b.push_back(q);
+    }
+  }
+  const GraphEdges small = GraphEdges::Grid(20, 20, 1), random(a, b), large = GraphEdges::Grid(40, 30, 1);
+  ExpansionWorkspace workspace;
+  int runs = 0;
+  for (const GraphEdges* edges : { &large, &small, &random, &large })
+    for (int labels : { 4, 3 })
+    {
+      PottsProblem pr;
+      pr.Nodes = edges == &large ? 1200 : 400;
+      pr.Labels = labels;
+      pr.Edges = edges;
+      for (std::int64_t e = 0; e < edges->Size(); ++e)
+        pr.Weight.push_back(0.5 + u(rng));
+      for (std::int64_t i = 0; i < pr.Nodes * labels; ++i)
+        pr.Cost.push_back(3.0 * u(rng));
+      const ExpansionResult lent = AlphaExpansion(pr, {}, NoProgress(), 8, nullptr, SerialFor(), &workspace);
+      const ExpansionResult fresh = AlphaExpansion(pr, {});
+      ASSERT_TRUE(lent.Error.empty() && fresh.Error.empty()) << lent.Error << fresh.Error;
+      EXPECT_EQ(lent.Label, fresh.Label) << "run " << runs;
+      EXPECT_EQ(lent.Energy, fresh.Energy) << "run " << runs;
+      EXPECT_GT(fresh.Moves, 0);
+      ++runs;
+    }
+  EXPECT_TRUE(workspace.Kept != nullptr);
+}
+
 TEST(AlphaExpansion, BadProblemsAreErrors)
 {
   const GraphEdges edges = GraphEdges::Grid(2, 2, 1);

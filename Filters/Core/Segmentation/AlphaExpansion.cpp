@@ -198,11 +198,14 @@ struct Neighbourhood
 {
   std::vector<double> Reach, Weight;
   std::vector<std::int64_t> First, Neighbour, Side;
-  explicit Neighbourhood(const PottsProblem& pr)
-    : Reach(pr.Nodes, 0.0)
-    , First(pr.Nodes + 1, 0)
+  Neighbourhood() = default;
+  explicit Neighbourhood(const PottsProblem& pr) { this->Build(pr); }
+  // Reuses the vectors' memory.
+  void Build(const PottsProblem& pr)
   {
     const std::int64_t n = pr.Nodes;
+    this->Reach.assign(n, 0.0);
+    this->First.assign(n + 1, 0);
     pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
       this->Reach[p] += pr.Weight[k];
       this->Reach[q] += pr.Weight[k];
@@ -373,6 +376,17 @@ struct RecycledMoves::State
   std::vector<std::uint8_t> Moved;
   std::vector<double> Terms;
 };
+
+struct ExpansionWorkspace::State
+{
+  Neighbourhood Around;
+  std::unique_ptr<Flow> Graph;
+  MoveBuffers Buffers;
+};
+ExpansionWorkspace::ExpansionWorkspace() = default;
+ExpansionWorkspace::~ExpansionWorkspace() = default;
+ExpansionWorkspace::ExpansionWorkspace(ExpansionWorkspace&&) noexcept = default;
+ExpansionWorkspace& ExpansionWorkspace::operator=(ExpansionWorkspace&&) noexcept = default;
 
 RecycledMoves::RecycledMoves() = default;
 RecycledMoves::~RecycledMoves() = default;
@@ -705,7 +719,7 @@ double RecycledMove(const PottsProblem& pr, int alpha, const std::vector<std::ui
 } // namespace
 
 ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t> label, const ProgressFunction& progress,
-  int maxCycles, RecycledMoves* recycled, const ParallelFor& parallel)
+  int maxCycles, RecycledMoves* recycled, const ParallelFor& parallel, ExpansionWorkspace* workspace)
 {
   ExpansionResult r;
   r.Error = Validate(pr, parallel);
@@ -726,12 +740,25 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
   try
   {
     RecycledMoves::State* kept = recycled ? SyncRecycled(*recycled, pr, label, parallel) : nullptr;
-    std::unique_ptr<Neighbourhood> own(kept ? nullptr : new Neighbourhood(pr));
-    const Neighbourhood& around = kept ? *kept->Around : *own;
-    std::unique_ptr<Flow> g(kept ? nullptr : new Flow(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory));
+    ExpansionWorkspace own;
+    ExpansionWorkspace::State* fresh = nullptr;
+    if (!kept)
+    {
+      ExpansionWorkspace& w = workspace ? *workspace : own;
+      if (!w.Kept)
+      {
+        w.Kept = std::make_unique<ExpansionWorkspace::State>();
+      }
+      fresh = w.Kept.get();
+      fresh->Around.Build(pr);
+      if (!fresh->Graph)
+      {
+        fresh->Graph = std::make_unique<Flow>(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory);
+      }
+    }
+    const Neighbourhood& around = kept ? *kept->Around : fresh->Around;
     const int total = std::max(1, maxCycles) * L;
     std::vector<std::int64_t> switched;
-    MoveBuffers buffers;
     // Done when every label's move has been tried since the last move that lowered the energy.
     int sinceLowered = 0;
     for (r.Cycles = 0; r.Cycles < std::max(1, maxCycles) && sinceLowered < L;)
@@ -745,7 +772,7 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
           return r;
         }
         const double change = kept ? RecycledMove(pr, alpha, label, *kept, switched, parallel)
-                                   : ExpansionMove(pr, alpha, label, around, *g, buffers, switched);
+                                   : ExpansionMove(pr, alpha, label, around, *fresh->Graph, fresh->Buffers, switched);
         if (!switched.empty() && change < -1e-9 * std::max(1.0, std::fabs(energy)))
         {
           for (const std::int64_t p : switched)
@@ -772,6 +799,10 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
     if (recycled)
     {
       recycled->Clear();
+    }
+    if (workspace)
+    {
+      workspace->Kept.reset();
     }
     r.Error = "not enough memory for the max-flow graph (" + std::to_string(n) + " nodes, " + std::to_string(m) + " edges).";
     return r;

@@ -520,6 +520,7 @@ struct VoxelRefinementCache::State
 {
   std::vector<std::int32_t> Index; // per image voxel: -1 between refinements
   std::unique_ptr<Flow> Graph;
+  ExpansionWorkspace Expansion;
 };
 VoxelRefinementCache::VoxelRefinementCache() = default;
 VoxelRefinementCache::~VoxelRefinementCache() = default;
@@ -602,7 +603,7 @@ VoxelRefinementResult RefineOnVoxels(const VoxelRefinementProblem& p, const Prog
     }
     // One cycle over the labels: from the elements' labels a second moved no case's Dice by more
     // than 0.001 and took as long again (docs/multilabel.md).
-    x = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.4, 1.0), 1, nullptr, p.Parallel);
+    x = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.4, 1.0), 1, nullptr, p.Parallel, &kept.Kept->Expansion);
     if (!x.Error.empty() || x.Aborted)
     {
       r.Error = x.Error;

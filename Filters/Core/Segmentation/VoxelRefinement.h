@@ -67,7 +67,8 @@ struct VoxelRefinementResult
 };
 
 // What a refinement keeps for the next (a seed edit's re-cut): a map of the image's voxels to the
-// band (4 bytes per voxel) and the max-flow graph's memory, so that neither is allocated afresh.
+// band (4 bytes per voxel) and the max-flow graph's (or the expansion's) memory, so that neither is
+// allocated afresh.
 class VoxelRefinementCache
 {
 public:
