@@ -59,7 +59,7 @@ def mesh_scores(case, edges, truth, shape, nodes_props):
     owner = np.where(owner < 0, owner.max() + 1, owner)
     scores = metrics.partition_scores(owner, truth)
     out = {"elements": fm.fetch(mesh).GetNumberOfCells(), "K": scores["K"], "oracle": scores["oracle_dice"],
-           "dice": fm.dice(fm.labels(cut), truth.ravel())}
+           "dice": fm.dice(fm.labels(cut), truth.ravel()), "elements_dice": fm.dice(fm.element_labels(cut, mesh), truth.ravel())}
     for p in (ids, cut, mesh, nodes):
         ps.Delete(p)
     return out
@@ -84,7 +84,8 @@ def run_case(case, args):
     seeded = mesh_scores(case, rsp, truth, shape, parse(args.nodes))
     row.update({"elements_canny": canny["elements"], "elements_rsp": seeded["elements"],
                 "oracle_canny": canny["oracle"], "oracle_rsp": seeded["oracle"],
-                "dice_canny": canny["dice"], "dice_rsp": seeded["dice"]})
+                "dice_canny": canny["dice"], "dice_rsp": seeded["dice"],
+                "dice_elements_canny": canny["elements_dice"], "dice_elements_rsp": seeded["elements_dice"]})
     if not args.no_slic:
         unit = metrics.unit_range(v2n(image.GetPointData().GetScalars()).reshape(shape))
         slic = metrics.slic_at_count(unit, truth, seeded["K"], image.GetSpacing())

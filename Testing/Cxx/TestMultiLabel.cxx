@@ -136,6 +136,23 @@ struct Plateaus
     return static_cast<double>(right) / this->G.Size();
   }
 };
+// `tries` random node pairs among `nodes`, self-loops left out: an irregular graph's edges.
+struct RandomPairs
+{
+  std::vector<std::int64_t> A, B;
+  RandomPairs(std::mt19937& rng, std::int64_t nodes, int tries)
+  {
+    for (int e = 0; e < tries; ++e)
+    {
+      const std::int64_t p = rng() % nodes, q = rng() % nodes;
+      if (p != q)
+      {
+        this->A.push_back(p);
+        this->B.push_back(q);
+      }
+    }
+  }
+};
 } // namespace
 
 TEST(AlphaExpansion, TwoLabelsReachTheGlobalMinimumAndThreeStayWithinTwice)
@@ -216,17 +233,8 @@ TEST(AlphaExpansion, RecycledMovesEqualFreshMoves)
   // graphs, gives the fresh one's labels (random real costs: no move has tied cuts).
   std::mt19937 rng(29);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<std::int64_t> a, b;
-  for (int e = 0; e < 1500; ++e)
-  {
-    const std::int64_t p = rng() % 400, q = rng() % 400;
-    if (p != q)
-    {
-      a.push_back(p);
-      b.push_back(q);
-    }
-  }
-  const GraphEdges grid = GraphEdges::Grid(20, 20, 1), random(a, b);
+  const RandomPairs pairs(rng, 400, 1500);
+  const GraphEdges grid = GraphEdges::Grid(20, 20, 1), random(pairs.A, pairs.B);
   for (const GraphEdges* edges : { &grid, &random })
     for (int labels : { 3, 5 })
     {
@@ -279,17 +287,8 @@ TEST(AlphaExpansion, AWorkspaceLentAcrossProblemsChangesNothing)
   // expansion's labels and energy.
   std::mt19937 rng(31);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<std::int64_t> a, b;
-  for (int e = 0; e < 1500; ++e)
-  {
-    const std::int64_t p = rng() % 400, q = rng() % 400;
-    if (p != q)
-    {
-      a.push_back(p);
-      b.push_back(q);
-    }
-  }
-  const GraphEdges small = GraphEdges::Grid(20, 20, 1), random(a, b), large = GraphEdges::Grid(40, 30, 1);
+  const RandomPairs pairs(rng, 400, 1500);
+  const GraphEdges small = GraphEdges::Grid(20, 20, 1), random(pairs.A, pairs.B), large = GraphEdges::Grid(40, 30, 1);
   ExpansionWorkspace workspace;
   int runs = 0;
   for (const GraphEdges* edges : { &large, &small, &random, &large })

@@ -24,7 +24,7 @@ DATA = os.environ.get("FEATUREMESH_DATA", os.path.join(ROOT, "Data"))
 SHARED = os.environ.get("FEATUREMESH_SHARED_DATA", os.path.join(os.path.dirname(ROOT), "shared", "data"))
 
 __all__ = ["ROOT", "DATA", "SHARED", "np", "v2n", "names", "find_plugin", "load_plugin", "cases", "case_dir", "seeds", "fetch",
-           "labels", "dice", "case_task", "Case", "open_image", "multilabel_cases", "MultiLabelCase", "label_names_from_csv"]
+           "labels", "element_labels", "dice", "case_task", "Case", "open_image", "multilabel_cases", "MultiLabelCase", "label_names_from_csv"]
 
 
 def find_plugin():
@@ -182,6 +182,18 @@ def fetch(proxy, port=0):
 def labels(cut, port=2):
     """The label image of a cut proxy (Super-Voxel Cut port 2, or Voxel Cut port 0) as a flat array."""
     return v2n(fetch(cut, port).GetPointData().GetScalars())
+
+
+def element_labels(cut, mesh):
+    """The Super-Voxel Cut's elements' labels on the voxels each element owns, flat (0 where none
+    does): the label image without the voxel refinement, the labelling the mesh's oracle bounds.
+    `mesh` is the cut's mesh proxy (stage 2 or 3), whose owner map it reads."""
+    owner = v2n(owner_map(mesh)).ravel().astype(np.int64)
+    cells = v2n(fetch(cut, 0).GetCellData().GetArray(names.Label))
+    out = np.zeros(owner.shape, dtype=cells.dtype)
+    inside = owner >= 0
+    out[inside] = cells[owner[inside]]
+    return out
 
 
 def parse_properties(text):

@@ -73,8 +73,8 @@ struct SuperVoxelCutParameters : SeededCutParameters
   bool SampleSeedElements = true;
   // Rings of elements along the cut whose voxels are labelled again by the voxel cut's energy
   // (VoxelRefinement.h): 1 the elements with a neighbour of another label, each more ring their
-  // neighbours too (2 by default: docs/cut.md); 0 off. The label image then follows the voxels where an element straddles the
-  // boundary; the elements keep their labels.
+  // neighbours too (2 by default: docs/cut.md); 0 off. The label image then follows the voxels
+  // where an element straddles the boundary; the elements keep their labels.
   int VoxelRefinement = 2;
 };
 
