@@ -907,7 +907,18 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
   {
     return r;
   }
-  r.BinCosts = costs;
+  // The voxel refinement's region term is the voxel cut's: from the voxels near each seed. The
+  // seed elements' voxels serve the elements, which they price as wholes.
+  if (par.VoxelRefinement > 0 && SamplesSeedElements(par))
+  {
+    std::vector<std::vector<double>> near(L, std::vector<double>(bins.Count(), 0.0));
+    SeedBallSamples(seeds, bins, mesh.Geometry(), par.SeedRadius, near);
+    r.BinCosts = LabelCosts(near, bins, multi.Channels, par.Bandwidth);
+  }
+  else
+  {
+    r.BinCosts = costs;
+  }
   r.BoundaryFaces = LabelBoundaryFaces(mesh, *faces, r.Label);
   return r;
 }
