@@ -54,13 +54,13 @@ def mesh_scores(case, edges, truth, shape, nodes_props):
     nodes = case.feature_nodes(edges, **nodes_props) if edges is not None else case.feature_nodes()
     mesh = case.smoothing(case.mesh(nodes))
     cut = case.super_voxel_cut(mesh)
-    ids = case.super_voxel_cut(mesh, SuperVoxelIds=1)
-    owner = v2n(fm.fetch(ids, 2).GetPointData().GetArray(fm.names.ElementId)).reshape(shape)
-    owner = np.where(owner < 0, owner.max() + 1, owner)
+    cut.UpdatePipeline()
+    raw = v2n(fm.owner_map(mesh)).astype(np.int64).ravel()
+    owner = np.where(raw < 0, raw.max() + 1, raw).reshape(shape)
     scores = metrics.partition_scores(owner, truth)
     out = {"elements": fm.fetch(mesh).GetNumberOfCells(), "K": scores["K"], "oracle": scores["oracle_dice"],
-           "dice": fm.dice(fm.labels(cut), truth.ravel()), "elements_dice": fm.dice(fm.element_labels(cut, mesh), truth.ravel())}
-    for p in (ids, cut, mesh, nodes):
+           "dice": fm.dice(fm.labels(cut), truth.ravel()), "elements_dice": fm.dice(fm.element_labels(cut, mesh, raw), truth.ravel())}
+    for p in (cut, mesh, nodes):
         ps.Delete(p)
     return out
 

@@ -184,11 +184,12 @@ def labels(cut, port=2):
     return v2n(fetch(cut, port).GetPointData().GetScalars())
 
 
-def element_labels(cut, mesh):
+def element_labels(cut, mesh, owner=None):
     """The Super-Voxel Cut's elements' labels on the voxels each element owns, flat (0 where none
     does): the label image without the voxel refinement, the labelling the mesh's oracle bounds.
-    `mesh` is the cut's mesh proxy (stage 2 or 3), whose owner map it reads."""
-    owner = v2n(owner_map(mesh)).ravel().astype(np.int64)
+    `mesh` is the cut's mesh proxy (stage 2 or 3), whose owner map it reads unless `owner` (that
+    map, flat) is given."""
+    owner = v2n(owner_map(mesh)).ravel().astype(np.int64) if owner is None else owner
     cells = v2n(fetch(cut, 0).GetCellData().GetArray(names.Label))
     out = np.zeros(owner.shape, dtype=cells.dtype)
     inside = owner >= 0
