@@ -107,7 +107,8 @@ struct MultiLabelResult
   double SetupSeconds = 0.0, ExpansionSeconds = 0.0, GeodesicSeconds = 0.0;
   std::int64_t ConnectivityChanged = 0;
   std::vector<std::int64_t> BoundaryFaces; // super-voxel cut: faces between labels and labels' hull faces
-  // The voxel refinement's terms (super-voxel cut): each label's -ln Pr per joint bin, and each
+  // The voxel refinement's terms (super-voxel cut): each label's -ln Pr per joint bin (from the
+  // voxels within SeedRadius of its seeds, as the voxel cut's), and each
   // node's spatial term per label as the expansion paid it (nodes x labels, lambda x size x the
   // term per voxel; empty without one).
   std::vector<std::vector<double>> BinCosts;
