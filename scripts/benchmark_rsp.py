@@ -55,7 +55,7 @@ def mesh_scores(case, edges, truth, shape, nodes_props):
     mesh = case.smoothing(case.mesh(nodes))
     cut = case.super_voxel_cut(mesh)
     cut.UpdatePipeline()
-    raw = v2n(fm.owner_map(mesh)).astype(np.int64).ravel()
+    raw = fm.element_owners(mesh)
     owner = np.where(raw < 0, raw.max() + 1, raw).reshape(shape)
     scores = metrics.partition_scores(owner, truth)
     out = {"elements": fm.fetch(mesh).GetNumberOfCells(), "K": scores["K"], "oracle": scores["oracle_dice"],

@@ -24,7 +24,7 @@ DATA = os.environ.get("FEATUREMESH_DATA", os.path.join(ROOT, "Data"))
 SHARED = os.environ.get("FEATUREMESH_SHARED_DATA", os.path.join(os.path.dirname(ROOT), "shared", "data"))
 
 __all__ = ["ROOT", "DATA", "SHARED", "np", "v2n", "names", "find_plugin", "load_plugin", "cases", "case_dir", "seeds", "fetch",
-           "labels", "element_labels", "dice", "case_task", "Case", "open_image", "multilabel_cases", "MultiLabelCase", "label_names_from_csv"]
+           "labels", "element_owners", "element_labels", "dice", "case_task", "Case", "open_image", "multilabel_cases", "MultiLabelCase", "label_names_from_csv"]
 
 
 def find_plugin():
@@ -184,12 +184,18 @@ def labels(cut, port=2):
     return v2n(fetch(cut, port).GetPointData().GetScalars())
 
 
+def element_owners(mesh):
+    """A stage 2 or 3 proxy's voxel -> element map as a flat int64 array, -1 where no element owns
+    the voxel."""
+    return v2n(owner_map(mesh)).ravel().astype(np.int64)
+
+
 def element_labels(cut, mesh, owner=None):
     """The Super-Voxel Cut's elements' labels on the voxels each element owns, flat (0 where none
     does): the label image without the voxel refinement, the labelling the mesh's oracle bounds.
-    `mesh` is the cut's mesh proxy (stage 2 or 3), whose owner map it reads unless `owner` (that
-    map, flat) is given."""
-    owner = v2n(owner_map(mesh)).ravel().astype(np.int64) if owner is None else owner
+    `mesh` is the cut's mesh proxy (stage 2 or 3), whose owner map it reads unless `owner`
+    (element_owners of it) is given."""
+    owner = element_owners(mesh) if owner is None else owner
     cells = v2n(fetch(cut, 0).GetCellData().GetArray(names.Label))
     out = np.zeros(owner.shape, dtype=cells.dtype)
     inside = owner >= 0

@@ -853,13 +853,17 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
   {
     return r;
   }
-  // Samples: the voxels of the seed elements, or those within SeedRadius of each seed.
-  std::vector<std::vector<double>> samples(L, std::vector<double>(bins.Count(), 0.0));
-  if (!SamplesSeedElements(par))
+  // Samples: the voxels of the seed elements, or those within SeedRadius of each seed. The voxel
+  // refinement's region term is the voxel cut's, from the latter: the seed elements' voxels serve
+  // the elements, which they price as wholes.
+  const bool elementSamples = SamplesSeedElements(par);
+  std::vector<std::vector<double>> near, samples(L, std::vector<double>(bins.Count(), 0.0));
+  if (!elementSamples || par.VoxelRefinement > 0)
   {
-    SeedBallSamples(seeds, bins, mesh.Geometry(), par.SeedRadius, samples);
+    near = samples;
+    SeedBallSamples(seeds, bins, mesh.Geometry(), par.SeedRadius, near);
   }
-  for (std::int64_t p = 0; p < n && SamplesSeedElements(par); ++p)
+  for (std::int64_t p = 0; p < n && elementSamples; ++p)
   {
     if (hard[p] >= 0)
     {
@@ -869,7 +873,7 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
       }
     }
   }
-  const std::vector<std::vector<double>> costs = LabelCosts(samples, bins, multi.Channels, par.Bandwidth);
+  const std::vector<std::vector<double>> costs = LabelCosts(elementSamples ? samples : near, bins, multi.Channels, par.Bandwidth);
   PottsProblem pr;
   pr.Nodes = n;
   pr.Labels = L;
@@ -907,18 +911,7 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
   {
     return r;
   }
-  // The voxel refinement's region term is the voxel cut's: from the voxels near each seed. The
-  // seed elements' voxels serve the elements, which they price as wholes.
-  if (par.VoxelRefinement > 0 && SamplesSeedElements(par))
-  {
-    std::vector<std::vector<double>> near(L, std::vector<double>(bins.Count(), 0.0));
-    SeedBallSamples(seeds, bins, mesh.Geometry(), par.SeedRadius, near);
-    r.BinCosts = LabelCosts(near, bins, multi.Channels, par.Bandwidth);
-  }
-  else
-  {
-    r.BinCosts = costs;
-  }
+  r.BinCosts = elementSamples && par.VoxelRefinement > 0 ? LabelCosts(near, bins, multi.Channels, par.Bandwidth) : costs;
   r.BoundaryFaces = LabelBoundaryFaces(mesh, *faces, r.Label);
   return r;
 }
