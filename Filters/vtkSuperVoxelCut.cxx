@@ -609,8 +609,7 @@ int vtkSuperVoxelCut::RequestMultiLabel(vtkUnstructuredGrid* input, const featur
   switch (values->GetDataType())
   {
     vtkTemplateMacro(perChannel = SeedBinsPerChannel(static_cast<const VTK_TT*>(values->GetVoidPointer(0)), channels,
-                       geometry, SamplesSeedElements(par) ? &mesh : nullptr, data.Cut.Owner.data(), seeds,
-                       par.SeedRadius, par.Bins, par.Bandwidth, &data.Bins));
+                       geometry, seeds, par.SeedRadius, par.Bins, par.Bandwidth, &data.Bins));
   }
   if (data.Bins.Channels != channels || data.Bins.PerChannel != perChannel)
   {

@@ -98,8 +98,8 @@ public:
   vtkGetMacro(VoxelRegionTerm, bool);
   vtkBooleanMacro(VoxelRegionTerm, bool);
   /// With the Image connected: the histograms sample the voxels of the seed elements (on), or the
-  /// voxels within SeedRadius of each seed, as the Voxel Cut does (off). With labelled seeds the
-  /// voxel refinement takes the latter either way.
+  /// voxels within SeedRadius of each seed, as the Voxel Cut does (off). Labelled seeds of several
+  /// objects, or several channels, always take the latter.
   vtkSetMacro(SampleSeedElements, bool);
   vtkGetMacro(SampleSeedElements, bool);
   vtkBooleanMacro(SampleSeedElements, bool);
@@ -114,8 +114,8 @@ public:
   /// the boundary; the mesh's elements keep their labels. Beyond [0, 8]: an error at execution.
   vtkSetMacro(VoxelRefinement, int);
   vtkGetMacro(VoxelRefinement, int);
-  /// Radius (voxels) of each seed's neighbourhood when SampleSeedElements is off, and for the voxel
-  /// refinement with labelled seeds.
+  /// Radius (voxels) of each seed's neighbourhood when SampleSeedElements is off, and with labelled
+  /// seeds of several objects or channels.
   vtkSetMacro(SeedRadius, double);
   vtkGetMacro(SeedRadius, double);
   /// With the Seeds input (port 4): the name of its label array or column (default Label, matched

@@ -146,7 +146,7 @@ int vtkVoxelCut::RequestMultiLabel(const featuremesh::LabelledSeeds& seeds, vtkD
   {
     vtkTemplateMacro(const VTK_TT* v = static_cast<const VTK_TT*>(array->GetVoidPointer(0));
                      binned = BinChannels(v, channels, n,
-                       SeedBinsPerChannel(v, channels, geometry, nullptr, nullptr, seeds, par.SeedRadius, par.Bins, par.Bandwidth),
+                       SeedBinsPerChannel(v, channels, geometry, seeds, par.SeedRadius, par.Bins, par.Bandwidth),
                        bins, error, SMPParallelFor());
                      if (binned) { values.assign(v, v + n * channels); });
     default:

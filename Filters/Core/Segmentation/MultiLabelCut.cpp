@@ -506,36 +506,17 @@ void NodeChannelMeans(const std::int32_t* owner, const T* values, int channels, 
 }
 
 template <typename T>
-int SeedBinsPerChannel(const T* values, int channels, const ImageGeometry& g, const SimplexMesh* mesh,
-  const std::int32_t* owner, const LabelledSeeds& seeds, double radius, int bins, double bandwidth,
-  const ChannelBins* binned)
+int SeedBinsPerChannel(const T* values, int channels, const ImageGeometry& g, const LabelledSeeds& seeds, double radius,
+  int bins, double bandwidth, const ChannelBins* binned)
 {
   if (bins > 0 || channels != 1 || seeds.Voxel.empty())
   {
     return BinsPerChannel(channels, bins);
   }
   std::vector<std::vector<double>> samples(LabelCount(seeds));
-  if (mesh && owner)
+  for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
   {
-    std::map<std::int32_t, std::uint8_t> element; // each seed element and its label
-    for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
-    {
-      if (owner[seeds.Voxel[s]] >= 0)
-      {
-        element[owner[seeds.Voxel[s]]] = seeds.Label[s];
-      }
-    }
-    for (const auto& e : element)
-    {
-      ForEachElementVoxel(*mesh, owner, e.first, [&](std::int64_t v) { samples[e.second].push_back(static_cast<double>(values[v])); });
-    }
-  }
-  else
-  {
-    for (std::size_t s = 0; s < seeds.Voxel.size(); ++s)
-    {
-      ForEachVoxelWithin(g, seeds.Voxel[s], radius, [&](std::int64_t v) { samples[seeds.Label[s]].push_back(static_cast<double>(values[v])); });
-    }
+    ForEachVoxelWithin(g, seeds.Voxel[s], radius, [&](std::int64_t v) { samples[seeds.Label[s]].push_back(static_cast<double>(values[v])); });
   }
   // The range the image was binned with, else the same percentiles afresh.
   const std::array<double, 2> range = binned && binned->Channels == 1 && binned->High.size() == 1
@@ -550,8 +531,8 @@ int SeedBinsPerChannel(const T* values, int channels, const ImageGeometry& g, co
 }
 
 #define FEATUREMESH_CHANNELS(T)                                                                                          \
-  template int SeedBinsPerChannel<T>(const T*, int, const ImageGeometry&, const SimplexMesh*, const std::int32_t*,      \
-    const LabelledSeeds&, double, int, double, const ChannelBins*);                                                     \
+  template int SeedBinsPerChannel<T>(                                                                                    \
+    const T*, int, const ImageGeometry&, const LabelledSeeds&, double, int, double, const ChannelBins*);                 \
   template bool BinChannels<T>(const T*, int, std::int64_t, int, ChannelBins&, std::string&, const ParallelFor&);       \
   template void NodeChannelMeans<T>(const std::int32_t*, const T*, int, std::int64_t, std::int64_t, std::vector<double>&, \
     std::vector<double>&);
@@ -853,27 +834,12 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
   {
     return r;
   }
-  // Samples: the voxels of the seed elements, or those within SeedRadius of each seed. The voxel
-  // refinement's region term is the voxel cut's, from the latter: the seed elements' voxels serve
-  // the elements, which they price as wholes.
-  const bool elementSamples = SamplesSeedElements(par);
-  std::vector<std::vector<double>> near, samples(L, std::vector<double>(bins.Count(), 0.0));
-  if (!elementSamples || par.VoxelRefinement > 0)
-  {
-    near = samples;
-    SeedBallSamples(seeds, bins, mesh.Geometry(), par.SeedRadius, near);
-  }
-  for (std::int64_t p = 0; p < n && elementSamples; ++p)
-  {
-    if (hard[p] >= 0)
-    {
-      for (std::int64_t k = runs.Offset[p]; k < runs.Offset[p + 1]; ++k)
-      {
-        samples[hard[p]][runs.Bin[k]] += runs.Count[k];
-      }
-    }
-  }
-  const std::vector<std::vector<double>> costs = LabelCosts(elementSamples ? samples : near, bins, multi.Channels, par.Bandwidth);
+  // Samples: the voxels within SeedRadius of each seed, for the elements and the voxel refinement
+  // alike. The seed elements' voxels (the binary cut's SampleSeedElements) gave several labels a
+  // worse model (docs/multilabel.md).
+  std::vector<std::vector<double>> samples(L, std::vector<double>(bins.Count(), 0.0));
+  SeedBallSamples(seeds, bins, mesh.Geometry(), par.SeedRadius, samples);
+  std::vector<std::vector<double>> costs = LabelCosts(samples, bins, multi.Channels, par.Bandwidth);
   PottsProblem pr;
   pr.Nodes = n;
   pr.Labels = L;
@@ -911,7 +877,7 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
   {
     return r;
   }
-  r.BinCosts = elementSamples && par.VoxelRefinement > 0 ? LabelCosts(near, bins, multi.Channels, par.Bandwidth) : costs;
+  r.BinCosts = std::move(costs);
   r.BoundaryFaces = LabelBoundaryFaces(mesh, *faces, r.Label);
   return r;
 }

@@ -66,13 +66,11 @@ int BinsPerChannel(int channels, int bins);
 
 // Bins per channel for labelled seeds: BinsPerChannel(channels, bins), except with automatic bins
 // (0) on one channel: AutomaticBins (BoykovJolly.h) of each label's samples on the channel's
-// 0.5-99.5 percentile range (`binned`'s, when it binned this image). The samples are the voxels of
-// the seeds' elements (`mesh` and its `owner` map) or, without them, those within `radius` of each
-// seed, as the cuts sample them.
+// 0.5-99.5 percentile range (`binned`'s, when it binned this image). The samples are the voxels
+// within `radius` of each seed, as both cuts sample them.
 template <typename T>
-int SeedBinsPerChannel(const T* values, int channels, const ImageGeometry& geometry, const SimplexMesh* mesh,
-  const std::int32_t* owner, const LabelledSeeds& seeds, double radius, int bins, double bandwidth,
-  const ChannelBins* binned = nullptr);
+int SeedBinsPerChannel(const T* values, int channels, const ImageGeometry& geometry, const LabelledSeeds& seeds,
+  double radius, int bins, double bandwidth, const ChannelBins* binned = nullptr);
 
 // `values` (voxels x channels, interleaved, any arithmetic type) binned into `out`; false with a
 // sentence for a value that is not finite or beyond +-1e150.
@@ -107,9 +105,9 @@ struct MultiLabelResult
   double SetupSeconds = 0.0, ExpansionSeconds = 0.0, GeodesicSeconds = 0.0;
   std::int64_t ConnectivityChanged = 0;
   std::vector<std::int64_t> BoundaryFaces; // super-voxel cut: faces between labels and labels' hull faces
-  // The voxel refinement's terms (super-voxel cut): each label's -ln Pr per joint bin (from the
-  // voxels within SeedRadius of its seeds, as the voxel cut's), and each
-  // node's spatial term per label as the expansion paid it (nodes x labels, lambda x size x the
+  // The voxel refinement's terms (super-voxel cut): each label's -ln Pr per joint bin (the cut's
+  // own, from the voxels within SeedRadius of its seeds), and each node's spatial term per label
+  // as the expansion paid it (nodes x labels, lambda x size x the
   // term per voxel; empty without one).
   std::vector<std::vector<double>> BinCosts;
   SharedArray<double> Spatial;
@@ -159,7 +157,7 @@ struct MultiLabelCache
 
 // The super-voxel cut with labelled seeds: `runs` and `mean` (elements x channels) from the image's
 // channels, `count` the elements' voxel counts. A seed's element takes its label (two labels in one
-// element are an error); the histograms sample the seed elements' voxels.
+// element are an error); the histograms sample the voxels within SeedRadius of each seed.
 MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutData& data, const ChannelBins& bins,
   const NodeBinRuns& runs, const std::vector<double>& mean, const std::vector<double>& count, const LabelledSeeds& seeds,
   const SuperVoxelCutParameters& parameters, const MultiLabelParameters& multi, const ParallelFor& parallel,

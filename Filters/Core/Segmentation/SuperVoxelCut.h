@@ -69,8 +69,8 @@ struct SuperVoxelCutParameters : SeededCutParameters
   // The histograms' samples: the voxels of the elements that hold seeds (true), or those within
   // SeedRadius of each seed voxel, as the voxel cut (false). The local contrast always takes the
   // latter: the elements follow the image's edges, not its contrast, and small seed elements give
-  // too few samples of it. With labelled seeds the voxel refinement takes the latter either way
-  // (docs/multilabel.md).
+  // too few samples of it. So do labelled seeds of several objects or channels, where the seed
+  // elements' voxels made the worse model (docs/multilabel.md).
   bool SampleSeedElements = true;
   // Rings of elements along the cut whose voxels are labelled again by the voxel cut's energy
   // (VoxelRefinement.h): 1 the elements with a neighbour of another label, each more ring their
