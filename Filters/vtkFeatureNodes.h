@@ -82,7 +82,8 @@ public:
   vtkSetMacro(ExclusionWindow, int);
   vtkGetMacro(ExclusionWindow, int);
 
-  /// Lattice spacing (voxels) of uniform points (default 7) and of boundary nodes (default 7).
+  /// Lattice spacing (voxels of the image's finest axis: even in world units on thick slices) of
+  /// uniform points (default 7) and of boundary nodes (default 7).
   vtkSetMacro(UniformSpacing, int);
   vtkGetMacro(UniformSpacing, int);
   vtkSetMacro(BoundarySpacing, int);

@@ -223,6 +223,70 @@ TEST(FeatureNodes, CornersAreNodesAndOneNodePerVoxel)
   EXPECT_GT(r.Counts[int(NodeType::Canny)], 0);
 }
 
+TEST(FeatureNodes, LatticesAreEvenInWorldUnitsOnThickSlices)
+{
+  // A constant volume (boundary and uniform nodes only) of 3 x 3 x 12 mm voxels, as a thick-slice
+  // CT: along every box edge the boundary nodes' gaps, and the uniform lattice's, are about as
+  // long in mm on each axis as the spacing in voxels of the finest axis (7 x 3 mm); steps in
+  // voxels on every axis gave 7 x 12 mm across the slices.
+  ImageGeometry g;
+  g.Dims = { { 60, 50, 12 } };
+  g.Spacing = { { 3.0, 3.0, 12.0 } };
+  const std::vector<float> f(g.Size(), 10.f);
+  FeatureNodeParameters p;
+  const auto r = ComputeFeatureNodes(f.data(), nullptr, g, p, SerialFor(), NoProgress());
+  ASSERT_EQ(r.Counts[int(NodeType::Canny)], 0);
+  // Largest gap (mm) between boundary nodes on the box edge along axis a (the other two at 0).
+  auto edgeGap = [&](int a) {
+    std::vector<int> at;
+    for (std::size_t n = 0; n < r.Positions.size(); ++n)
+    {
+      const auto& x = r.Positions[n];
+      if (r.Type[n] == NodeType::Boundary && x[(a + 1) % 3] == 0 && x[(a + 2) % 3] == 0)
+        at.push_back(x[a]);
+    }
+    std::sort(at.begin(), at.end());
+    int gap = 0;
+    for (std::size_t k = 1; k < at.size(); ++k)
+      gap = std::max(gap, at[k] - at[k - 1]);
+    return gap * g.Spacing[a];
+  };
+  const double mean = 3.0 * p.BoundarySpacing; // 21 mm
+  for (int a = 0; a < 3; ++a)
+  {
+    EXPECT_GT(edgeGap(a), 0.6 * mean) << "axis " << a;
+    EXPECT_LT(edgeGap(a), 1.4 * mean) << "axis " << a;
+  }
+  // The uniform lattice: the smallest gap between two uniform nodes on one line along each axis.
+  std::array<double, 3> step{ { 1e300, 1e300, 1e300 } };
+  for (std::size_t m = 0; m < r.Positions.size(); ++m)
+    for (std::size_t n = 0; n < r.Positions.size(); ++n)
+    {
+      if (r.Type[m] != NodeType::Uniform || r.Type[n] != NodeType::Uniform)
+        continue;
+      const auto &x = r.Positions[m], &y = r.Positions[n];
+      for (int a = 0; a < 3; ++a)
+        if (y[a] > x[a] && y[(a + 1) % 3] == x[(a + 1) % 3] && y[(a + 2) % 3] == x[(a + 2) % 3])
+          step[a] = std::min(step[a], (y[a] - x[a]) * g.Spacing[a]);
+    }
+  for (int a = 0; a < 3; ++a)
+  {
+    EXPECT_GT(step[a], 0.6 * mean) << "axis " << a;
+    EXPECT_LT(step[a], 1.4 * mean) << "axis " << a;
+  }
+  // Isotropic voxels of any size keep the step in voxels.
+  g.Spacing = { { 0.7, 0.7, 0.7 } };
+  const auto iso = ComputeFeatureNodes(f.data(), nullptr, g, p, SerialFor(), NoProgress());
+  int lastX = -1;
+  for (std::size_t n = 0; n < iso.Positions.size(); ++n)
+    if (iso.Type[n] == NodeType::Uniform && iso.Positions[n][1] == iso.Positions[0][1] && iso.Positions[n][2] == iso.Positions[0][2])
+    {
+      if (lastX >= 0)
+        EXPECT_EQ(iso.Positions[n][0] - lastX, p.UniformSpacing);
+      lastX = iso.Positions[n][0];
+    }
+}
+
 TEST(FeatureNodes, VolumeNodesDoNotDependOnHowLoopsAreSplit)
 {
   // A noisy ball in a box: the 3D paths (slice-blocked Gaussian, 26-connected hysteresis, packed

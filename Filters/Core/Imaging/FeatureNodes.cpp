@@ -8,6 +8,7 @@
 #include "ImagingInternals.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -24,12 +25,33 @@ double SecondsSince(Clock::time_point t0)
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// True when some voxel within the centred box of half-width h around (i,j,k) is set in mask.
-bool AnyInBox(const std::vector<std::uint8_t>& mask, const ImageGeometry& g, int i, int j, int k, int h)
+// `voxels` voxels of the image's finest axis, per axis in that axis's voxels (at least `least`):
+// the lattices' steps and windows are even in world units on an anisotropic grid. Steps in voxels
+// leave the box's edges dense across thin slices and sparse across thick ones (slivers stage 3
+// cannot mend) and stage 3 fills the thick slices' gaps with nodes (docs/smoothing.md). An
+// isotropic grid keeps `voxels` on every axis.
+std::array<int, 3> EvenSteps(const ImageGeometry& g, int voxels, int least)
 {
-  const int k0 = std::max(0, k - h), k1 = std::min(g.Dims[2] - 1, k + h);
-  const int j0 = std::max(0, j - h), j1 = std::min(g.Dims[1] - 1, j + h);
-  const int i0 = std::max(0, i - h), i1 = std::min(g.Dims[0] - 1, i + h);
+  const int axes = g.Is2D() ? 2 : 3;
+  double finest = 1e300;
+  for (int a = 0; a < axes; ++a)
+  {
+    finest = std::min(finest, std::fabs(g.Spacing[a]));
+  }
+  std::array<int, 3> step{ { voxels, voxels, voxels } };
+  for (int a = 0; a < axes; ++a)
+  {
+    step[a] = std::max(least, static_cast<int>(std::lround(voxels * finest / std::fabs(g.Spacing[a]))));
+  }
+  return step;
+}
+
+// True when some voxel within the centred box of half-widths h around (i,j,k) is set in mask.
+bool AnyInBox(const std::vector<std::uint8_t>& mask, const ImageGeometry& g, int i, int j, int k, const std::array<int, 3>& h)
+{
+  const int k0 = std::max(0, k - h[2]), k1 = std::min(g.Dims[2] - 1, k + h[2]);
+  const int j0 = std::max(0, j - h[1]), j1 = std::min(g.Dims[1] - 1, j + h[1]);
+  const int i0 = std::max(0, i - h[0]), i1 = std::min(g.Dims[0] - 1, i + h[0]);
   for (int kk = k0; kk <= k1; ++kk)
   {
     for (int jj = j0; jj <= j1; ++jj)
@@ -282,9 +304,10 @@ struct Coarsening
 // Step 3: boundary nodes, corners always, evenly spaced along the border (2D) or on the box faces (3D).
 void PlaceBoundaryNodes(const ImageGeometry& g, int spacing, const Coarsening& level, NodePlacer& nodes)
 {
-  const std::vector<int> px = EvenPositions(g.Dims[0], spacing);
-  const std::vector<int> py = EvenPositions(g.Dims[1], spacing);
-  const std::vector<int> pz = EvenPositions(g.Dims[2], spacing);
+  const std::array<int, 3> step = EvenSteps(g, spacing, 1);
+  const std::vector<int> px = EvenPositions(g.Dims[0], step[0]);
+  const std::vector<int> py = EvenPositions(g.Dims[1], step[1]);
+  const std::vector<int> pz = EvenPositions(g.Dims[2], step[2]);
   const float r = 0.5f * spacing;
   const int lx = g.Dims[0] - 1, ly = g.Dims[1] - 1, lz = g.Dims[2] - 1;
   const int nx = static_cast<int>(px.size()), ny = static_cast<int>(py.size()), nz = static_cast<int>(pz.size());
@@ -321,19 +344,20 @@ void PlaceUniformNodes(const ImageGeometry& g, int spacing, int h, const std::ve
   }
   const bool is2D = g.Is2D();
   const int s = spacing;
-  const int start = s / 2;
-  for (int k = is2D ? 0 : start; k < g.Dims[2]; k += s)
+  const std::array<int, 3> step = EvenSteps(g, spacing, 1), window = EvenSteps(g, h, 0);
+  const std::array<int, 3> start{ { step[0] / 2, step[1] / 2, step[2] / 2 } };
+  for (int k = is2D ? 0 : start[2]; k < g.Dims[2]; k += step[2])
   {
-    for (int j = start; j < g.Dims[1]; j += s)
+    for (int j = start[1]; j < g.Dims[1]; j += step[1])
     {
-      for (int i = start; i < g.Dims[0]; i += s)
+      for (int i = start[0]; i < g.Dims[0]; i += step[0])
       {
         const int m = 1 << level(i, j, k);
-        if (((i - start) / s) % m || ((j - start) / s) % m || (!is2D && ((k - start) / s) % m))
+        if (((i - start[0]) / step[0]) % m || ((j - start[1]) / step[1]) % m || (!is2D && ((k - start[2]) / step[2]) % m))
         {
           continue;
         }
-        if (!AnyInBox(nodes.Occupied, g, i, j, k, h))
+        if (!AnyInBox(nodes.Occupied, g, i, j, k, window))
         {
           nodes.Add(i, j, k, NodeType::Uniform, 0.5f * s);
         }
@@ -382,7 +406,8 @@ bool PlaceHalftoneNodes(const float* image, float* f, float* work, const ImageGe
   {
     int i, j, k;
     Coordinates(g, d, i, j, k);
-    if (!AnyInBox(out.EdgeMap, g, i, j, k, h) && (allCanny.empty() || !AnyInBox(allCanny, g, i, j, k, h)))
+    const std::array<int, 3> box{ { h, h, h } };
+    if (!AnyInBox(out.EdgeMap, g, i, j, k, box) && (allCanny.empty() || !AnyInBox(allCanny, g, i, j, k, box)))
     {
       nodes.Add(i, j, k, NodeType::Halftone, static_cast<float>(h));
     }

@@ -53,6 +53,8 @@ struct FeatureNodeParameters
   // Edge of the window (voxels) that must be free of Canny points for a halftone point, and of
   // any node for a uniform point.
   int ExclusionWindow = 7;
+  // The uniform and boundary lattices' spacing, in voxels of the finest axis (the uniform points'
+  // window too): even in world units on thick slices.
   int UniformSpacing = 7;
   int BoundarySpacing = 7;
   // With an edge map supplied (a sparse, seed-driven one such as RSP Edge Enhancement's), SeedAware
