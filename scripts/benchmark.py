@@ -175,7 +175,7 @@ def run_case(case, args):
             if key == "random_walker":
                 row["random_walker_scale"] = scale
     if not args.no_slic:
-        mine = metrics.partition_scores(np.where(owners < 0, owners.max() + 1, owners).reshape(shape), truth)
+        mine = metrics.partition_scores(owners.reshape(shape), truth)
         slic = metrics.slic_at_count(unit, truth, mine["K"], spacing)
         row.update({"K": mine["K"], "oracle_dice_mesh": mine["oracle_dice"], "oracle_dice_slic": slic["oracle_dice"],
                     "asa_mesh": mine["asa"], "asa_slic": slic["asa"],

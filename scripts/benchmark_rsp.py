@@ -55,11 +55,10 @@ def mesh_scores(case, edges, truth, shape, nodes_props):
     mesh = case.smoothing(case.mesh(nodes))
     cut = case.super_voxel_cut(mesh)
     cut.UpdatePipeline()
-    raw = fm.element_owners(mesh)
-    owner = np.where(raw < 0, raw.max() + 1, raw).reshape(shape)
-    scores = metrics.partition_scores(owner, truth)
+    owner = fm.element_owners(mesh)
+    scores = metrics.partition_scores(owner.reshape(shape), truth)
     out = {"elements": fm.fetch(mesh).GetNumberOfCells(), "K": scores["K"], "oracle": scores["oracle_dice"],
-           "dice": fm.dice(fm.labels(cut), truth.ravel()), "elements_dice": fm.dice(fm.element_labels(cut, mesh, raw), truth.ravel())}
+           "dice": fm.dice(fm.labels(cut), truth.ravel()), "elements_dice": fm.dice(fm.element_labels(cut, mesh, owner), truth.ravel())}
     for p in (cut, mesh, nodes):
         ps.Delete(p)
     return out

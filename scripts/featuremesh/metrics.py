@@ -63,8 +63,11 @@ def boundary_recall(segments, truth, tolerance=1):
 
 
 def partition_scores(segments, truth):
-    """K, oracle Dice, ASA and boundary recall of a label image of segments (ids 0..K-1)."""
+    """K, oracle Dice, ASA and boundary recall of a label image of segments (ids 0..K-1; -1, a voxel
+    no element owns, counts as one segment more)."""
     segments = np.asarray(segments)
+    if segments.min() < 0:
+        segments = np.where(segments < 0, segments.max() + 1, segments)
     flat = segments.ravel()
     k = int(flat.max()) + 1
     count = np.bincount(flat, minlength=k)

@@ -8,6 +8,7 @@
 // world coordinates differ by a rigid motion, mirrors included).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -35,6 +36,12 @@ struct ImageGeometry
   double VoxelVolume() const
   {
     return std::fabs(Spacing[0] * Spacing[1]) * (Is2D() ? 1.0 : std::fabs(Spacing[2]));
+  }
+  // The smallest |spacing| over the image's axes (2D: the first two).
+  double FinestSpacing() const
+  {
+    const double inPlane = std::min(std::fabs(Spacing[0]), std::fabs(Spacing[1]));
+    return Is2D() ? inPlane : std::min(inPlane, std::fabs(Spacing[2]));
   }
   std::int64_t SliceStride() const { return static_cast<std::int64_t>(Dims[0]) * Dims[1]; }
   // The (i, j, k) of a voxel index: the inverse of Index.

@@ -32,14 +32,9 @@ double SecondsSince(Clock::time_point t0)
 // isotropic grid keeps `voxels` on every axis.
 std::array<int, 3> EvenSteps(const ImageGeometry& g, int voxels, int least)
 {
-  const int axes = g.Is2D() ? 2 : 3;
-  double finest = 1e300;
-  for (int a = 0; a < axes; ++a)
-  {
-    finest = std::min(finest, std::fabs(g.Spacing[a]));
-  }
+  const double finest = g.FinestSpacing();
   std::array<int, 3> step{ { voxels, voxels, voxels } };
-  for (int a = 0; a < axes; ++a)
+  for (int a = 0; a < g.Dimension(); ++a)
   {
     step[a] = std::max(least, static_cast<int>(std::lround(voxels * finest / std::fabs(g.Spacing[a]))));
   }

@@ -33,11 +33,7 @@ constexpr float Infinity = std::numeric_limits<float>::infinity();
 // Step lengths of the three axes in units of the smallest spacing (1 along a one-voxel axis).
 std::array<double, 3> AxisSteps(const ImageGeometry& g)
 {
-  double h = std::numeric_limits<double>::max();
-  for (int a = 0; a < g.Dimension(); ++a)
-  {
-    h = std::min(h, std::fabs(g.Spacing[a]));
-  }
+  const double h = g.FinestSpacing();
   std::array<double, 3> s{ { 1, 1, 1 } };
   for (int a = 0; a < g.Dimension(); ++a)
   {

@@ -107,8 +107,7 @@ struct MultiLabelResult
   std::vector<std::int64_t> BoundaryFaces; // super-voxel cut: faces between labels and labels' hull faces
   // The voxel refinement's terms (super-voxel cut): each label's -ln Pr per joint bin (the cut's
   // own, from the voxels within SeedRadius of its seeds), and each node's spatial term per label
-  // as the expansion paid it (nodes x labels, lambda x size x the
-  // term per voxel; empty without one).
+  // as the expansion paid it (nodes x labels, lambda x size x the term per voxel; empty without one).
   std::vector<std::vector<double>> BinCosts;
   SharedArray<double> Spatial;
   std::string Error;

@@ -732,9 +732,7 @@ void SetSlideNormals(Smoother& s, const std::vector<std::uint8_t>& fixed, const 
   const std::int64_t n = static_cast<std::int64_t>(s.Points.size());
   const int vpc = s.Topology.VerticesPerCell();
   // Voxels to frame units: the finest spacing of the image's axes.
-  double finest = std::min(std::fabs(g.Spacing[0]), std::fabs(g.Spacing[1]));
-  finest = g.Is2D() ? finest : std::min(finest, std::fabs(g.Spacing[2]));
-  s.Slack = slack * finest;
+  s.Slack = slack * g.FinestSpacing();
   s.Normal.assign(n, V3{ { 0, 0, 0 } });
   for (std::int64_t v = 0; v < n; ++v)
   {
