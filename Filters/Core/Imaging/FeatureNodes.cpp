@@ -397,11 +397,11 @@ bool PlaceHalftoneNodes(const float* image, float* f, float* work, const ImageGe
   }
   t0 = Clock::now();
   const int h = p.ExclusionWindow / 2;
+  const std::array<int, 3> box{ { h, h, h } }; // in voxels on every axis, as the halftone's density
   for (std::int64_t d : Halftone(rho, g, p.HalftoneThreshold))
   {
     int i, j, k;
     Coordinates(g, d, i, j, k);
-    const std::array<int, 3> box{ { h, h, h } };
     if (!AnyInBox(out.EdgeMap, g, i, j, k, box) && (allCanny.empty() || !AnyInBox(allCanny, g, i, j, k, box)))
     {
       nodes.Add(i, j, k, NodeType::Halftone, static_cast<float>(h));
