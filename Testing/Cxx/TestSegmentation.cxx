@@ -1218,6 +1218,67 @@ TEST(VoxelRefinement, TheBandFollowsTheVoxelsAndTheRestKeepsItsElements)
   }
 }
 
+TEST(VoxelRefinement, TwoLabelComponentsCutApartAsOne)
+{
+  // Grids with random costs and weights: apart (each its own graph's component), the labels equal
+  // those of the same grids joined by edges of weight 0 (one component, one graph), and the energy
+  // is the minimum, found by enumeration on the smallest.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (const int side : { 2, 3, 12 })
+  {
+    const int grids = side == 2 ? 3 : 4, per = side * side, n = grids * per;
+    std::vector<std::int64_t> a, b;
+    for (int g = 0; g < grids; ++g)
+      for (int j = 0; j < side; ++j)
+        for (int i = 0; i < side; ++i)
+        {
+          const int v = g * per + j * side + i;
+          if (i + 1 < side)
+            a.push_back(v), b.push_back(v + 1);
+          if (j + 1 < side)
+            a.push_back(v), b.push_back(v + side);
+        }
+    PottsProblem apart;
+    apart.Nodes = n;
+    apart.Labels = 2;
+    for (std::size_t e = 0; e < a.size(); ++e)
+      apart.Weight.push_back(0.2 + u(rng));
+    for (int i = 0; i < 2 * n; ++i)
+      apart.Cost.push_back(2.0 * u(rng));
+    const GraphEdges apartEdges = GraphEdges::Owned(a, b);
+    apart.Edges = &apartEdges;
+    PottsProblem joined = apart;
+    for (int g = 0; g + 1 < grids; ++g)
+      a.push_back(g * per), b.push_back((g + 1) * per), joined.Weight.push_back(0.0);
+    const GraphEdges joinedEdges = GraphEdges::Owned(a, b);
+    joined.Edges = &joinedEdges;
+    std::vector<std::uint8_t> split, one, chunked;
+    const double energy = BinaryPottsCut(apart, split, SerialFor());
+    EXPECT_NEAR(BinaryPottsCut(joined, one, SerialFor()), energy, 1e-12 * energy);
+    EXPECT_EQ(split, one);
+    EXPECT_EQ(BinaryPottsCut(apart, chunked, Chunked), energy);
+    EXPECT_EQ(chunked, split);
+    const auto ones = std::count(split.begin(), split.end(), 1);
+    EXPECT_GT(ones, 0);
+    EXPECT_LT(ones, n);
+    if (n > 16)
+      continue;
+    double best = 1e300;
+    for (int code = 0; code < (1 << n); ++code)
+    {
+      double sum = 0.0;
+      for (int i = 0; i < n; ++i)
+        sum += apart.Cost[2 * i + ((code >> i) & 1)];
+      apartEdges.ForEach([&](std::int64_t e, std::int64_t p, std::int64_t q) {
+        sum += ((code >> p) & 1) != ((code >> q) & 1) ? apart.Weight[e] : 0.0;
+      });
+      best = std::min(best, sum);
+    }
+    EXPECT_NEAR(energy, best, 1e-12 * best);
+  }
+}
+
 TEST(VoxelRefinement, ExpansionLowersTheBandsEnergy)
 {
   // Three labels with weights between equal values: the refined voxels' energy (their costs and a

@@ -6,6 +6,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <memory>
 #include <numeric>
 #include <stdexcept>
@@ -39,6 +40,100 @@ double BinaryCut(const PottsProblem& pr, Flow& g, std::vector<std::uint8_t>& lab
     label[i] = g.what_segment(static_cast<int>(i)) == Flow::SOURCE ? 1 : 0;
   }
   return energy;
+}
+
+// BinaryPottsCut on kept graphs.
+double CutOnGraphs(const PottsProblem& pr, std::array<std::unique_ptr<Flow>, 2>& graphs, std::vector<std::uint8_t>& label,
+  const ParallelFor& parallel)
+{
+  const std::int64_t n = pr.Nodes;
+  std::int64_t count = 0;
+  const std::vector<std::int64_t> component = LabelComponents(std::vector<std::uint8_t>(n, 0), *pr.Edges, count);
+  std::vector<std::int64_t> size(count, 0);
+  for (std::int64_t c : component)
+  {
+    ++size[c];
+  }
+  // A kept graph grows as libmaxflow's do; a new one is made for this problem's share.
+  const auto make = [&](std::unique_ptr<Flow>& g, std::int64_t nodes) {
+    if (!g)
+    {
+      const std::int64_t edges = pr.Edges->Size() * nodes / std::max<std::int64_t>(n, 1);
+      g = std::make_unique<Flow>(static_cast<int>(nodes), static_cast<int>(edges), ThrowOutOfMemory);
+    }
+  };
+  if (count < 2 || 4 * *std::max_element(size.begin(), size.end()) > 3 * n)
+  {
+    make(graphs[0], n);
+    return BinaryCut(pr, *graphs[0], label);
+  }
+  std::vector<std::uint8_t> side(count);
+  std::array<std::int64_t, 2> load{ { 0, 0 } };
+  for (std::int64_t c = 0; c < count; ++c)
+  {
+    side[c] = load[1] < load[0] ? 1 : 0;
+    load[side[c]] += size[c];
+  }
+  // Each node's index in its side's graph.
+  std::vector<std::int32_t> local(n);
+  std::array<std::int32_t, 2> nodes{ { 0, 0 } };
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    local[i] = nodes[side[component[i]]]++;
+  }
+  make(graphs[0], nodes[0]);
+  make(graphs[1], nodes[1]);
+  std::array<double, 2> energy{ { 0.0, 0.0 } };
+  label.resize(n);
+  const auto cut = [&](std::int64_t s) {
+    Flow& g = *graphs[s];
+    g.reset();
+    g.add_node(nodes[s]);
+    for (std::int64_t i = 0; i < n; ++i)
+    {
+      if (side[component[i]] == s)
+      {
+        g.add_tweights(local[i], pr.Cost[2 * i], pr.Cost[2 * i + 1]);
+      }
+    }
+    pr.Edges->ForEach([&](std::int64_t e, std::int64_t a, std::int64_t b) {
+      if (side[component[a]] == s)
+      {
+        g.add_edge(local[a], local[b], pr.Weight[e], pr.Weight[e]);
+      }
+    });
+    energy[s] = g.maxflow();
+    for (std::int64_t i = 0; i < n; ++i)
+    {
+      if (side[component[i]] == s)
+      {
+        label[i] = g.what_segment(local[i]) == Flow::SOURCE ? 1 : 0;
+      }
+    }
+  };
+  // Out of memory on a worker thread is rethrown on the caller's.
+  std::array<std::exception_ptr, 2> error;
+  parallel(2, 1, [&](std::int64_t s0, std::int64_t s1) {
+    for (std::int64_t s = s0; s < s1; ++s)
+    {
+      try
+      {
+        cut(s);
+      }
+      catch (...)
+      {
+        error[s] = std::current_exception();
+      }
+    }
+  });
+  for (const std::exception_ptr& e : error)
+  {
+    if (e)
+    {
+      std::rethrow_exception(e);
+    }
+  }
+  return energy[0] + energy[1];
 }
 
 // Elements within `rings` face steps of an element of another label, seed elements left out, and
@@ -519,7 +614,7 @@ std::vector<double> ComponentChanges(const VoxelRefinementProblem& p, const Voxe
 struct VoxelRefinementCache::State
 {
   std::vector<std::int32_t> Index; // per image voxel: -1 between refinements
-  std::unique_ptr<Flow> Graph;
+  std::array<std::unique_ptr<Flow>, 2> Graphs;
   ExpansionWorkspace Expansion;
 };
 VoxelRefinementCache::VoxelRefinementCache() = default;
@@ -581,12 +676,7 @@ VoxelRefinementResult RefineOnVoxels(const VoxelRefinementProblem& p, const Prog
   {
     try
     {
-      std::unique_ptr<Flow>& g = kept.Kept->Graph;
-      if (!g)
-      {
-        g = std::make_unique<Flow>(static_cast<int>(nb), static_cast<int>(edges.Size()), ThrowOutOfMemory);
-      }
-      x.Energy = BinaryCut(pr, *g, x.Label);
+      x.Energy = CutOnGraphs(pr, kept.Kept->Graphs, x.Label, p.Parallel);
     }
     catch (const std::exception&)
     {
@@ -633,6 +723,12 @@ VoxelRefinementResult RefineOnVoxels(const VoxelRefinementProblem& p, const Prog
   }
   r.Seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return r;
+}
+
+double BinaryPottsCut(const PottsProblem& problem, std::vector<std::uint8_t>& label, const ParallelFor& parallel)
+{
+  std::array<std::unique_ptr<Flow>, 2> graphs;
+  return CutOnGraphs(problem, graphs, label, parallel);
 }
 
 void ApplyRefinement(const VoxelRefinementResult& refinement, std::uint8_t* labels)
