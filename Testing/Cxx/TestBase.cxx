@@ -3,6 +3,7 @@
 #include "ElementRasterizer.h"
 #include "ImageGeometry.h"
 #include "SimplexMesh.h"
+#include "Vector3.h"
 #include "Parallel.h"
 #include "TestHelpers.h"
 
@@ -72,6 +73,45 @@ TEST_P(Tiling, EveryCentreHasExactlyOneOwner)
   // Hull faces cover the box surface: their measure sums to its area/perimeter.
   const FaceAdjacency& adj = simplices.Faces();
   EXPECT_EQ(2 * adj.A.size() + adj.HullElement.size(), mesh.Cells.size());
+  // The adjacency against a map of every element face by its sorted vertices: interior faces in
+  // the order of those vertices, each with its two elements (the smaller first), their local faces
+  // and its measure; the hull faces are the rest.
+  const int vpc = mesh.VerticesPerCell;
+  std::map<std::array<std::int64_t, 3>, std::vector<std::pair<std::int64_t, int>>> byVertices;
+  for (std::int64_t e = 0; e < simplices.NumberOfElements(); ++e)
+    for (int f = 0; f < vpc; ++f)
+    {
+      std::array<std::int64_t, 3> key{ { -1, -1, -1 } };
+      int k = 0;
+      for (int j = 0; j < vpc; ++j)
+        if (j != f)
+          key[k++] = simplices.Cell(e)[j];
+      std::sort(key.begin(), key.begin() + vpc - 1);
+      byVertices[key].emplace_back(e, f);
+    }
+  std::size_t interior = 0, hull = 0;
+  const std::vector<std::array<double, 3>> frame = simplices.FramePoints();
+  for (const auto& [key, sides] : byVertices)
+  {
+    ASSERT_LE(sides.size(), 2u);
+    if (sides.size() == 1)
+    {
+      ASSERT_LT(hull, adj.HullElement.size());
+      EXPECT_EQ(adj.HullElement[hull], sides[0].first);
+      EXPECT_EQ(adj.HullFace[hull++], sides[0].second);
+      continue;
+    }
+    ASSERT_LT(interior, adj.A.size());
+    EXPECT_EQ(adj.A[interior], sides[0].first);
+    EXPECT_EQ(adj.B[interior], sides[1].first);
+    EXPECT_EQ(adj.LocalA[interior], sides[0].second);
+    EXPECT_EQ(adj.LocalB[interior], sides[1].second);
+    const vector3::V3 u = vector3::Sub(frame[key[1]], frame[key[0]]);
+    const double measure = vpc == 3 ? vector3::Norm(u) : 0.5 * vector3::Norm(vector3::Cross(u, vector3::Sub(frame[key[2]], frame[key[0]])));
+    EXPECT_NEAR(adj.Measure[interior++], measure, 1e-12 * (1.0 + measure));
+  }
+  EXPECT_EQ(interior, adj.A.size());
+  EXPECT_EQ(hull, adj.HullElement.size());
 }
 INSTANTIATE_TEST_SUITE_P(Delaunay, Tiling, ::testing::Values(0, 1, 2));
 

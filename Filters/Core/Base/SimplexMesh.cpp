@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numeric>
 
 namespace featuremesh
@@ -60,47 +61,55 @@ FaceAdjacency BuildFaces(
   const std::int64_t m = static_cast<std::int64_t>(cells.size()) / vpc;
   const int fv = vpc - 1; // vertices per face
   const std::int64_t nFaces = m * vpc;
-  struct Face
-  {
-    std::int64_t v[3];
-    std::int64_t element;
-    int local;
+  // Face `local` of element e (its vertices but that one), sorted.
+  const auto faceOf = [&](std::int64_t e, int local, std::int64_t* v) {
+    int k = 0;
+    for (int j = 0; j < vpc; ++j)
+    {
+      if (j != local)
+      {
+        v[k++] = cells[e * vpc + j];
+      }
+    }
+    v[2] = fv == 2 ? -1 : v[2];
+    std::sort(v, v + fv);
   };
-  std::vector<Face> faces(nFaces);
+  // Faces bucketed by their smallest vertex; within a bucket by the other two, then by face id
+  // (e * vpc + local): the two faces of an interior face meet. The records are written in bucket
+  // order, so that the sorts and the matching read them in sequence.
   std::vector<std::int64_t> bucketStart(P.size() + 1, 0);
   for (std::int64_t e = 0; e < m; ++e)
   {
     for (int f = 0; f < vpc; ++f)
     {
-      Face& face = faces[e * vpc + f];
-      int k = 0;
-      for (int v = 0; v < vpc; ++v)
+      std::int64_t least = -1;
+      for (int j = 0; j < vpc; ++j)
       {
-        if (v != f)
-        {
-          face.v[k++] = cells[e * vpc + v];
-        }
+        const std::int64_t v = cells[e * vpc + j];
+        least = j != f && (least < 0 || v < least) ? v : least;
       }
-      if (fv == 2)
-      {
-        face.v[2] = -1;
-      }
-      std::sort(face.v, face.v + fv);
-      face.element = e;
-      face.local = f;
-      bucketStart[face.v[0] + 1]++;
+      ++bucketStart[least + 1];
     }
   }
   for (size_t i = 1; i < bucketStart.size(); ++i)
   {
     bucketStart[i] += bucketStart[i - 1];
   }
-  std::vector<std::int64_t> order(nFaces);
+  struct Face
+  {
+    std::int64_t V1, V2, Id;
+  };
+  std::unique_ptr<Face[]> faces(new Face[nFaces]); // every record is written below
   {
     std::vector<std::int64_t> fill(bucketStart.begin(), bucketStart.end() - 1);
-    for (std::int64_t i = 0; i < nFaces; ++i)
+    for (std::int64_t e = 0; e < m; ++e)
     {
-      order[fill[faces[i].v[0]]++] = i;
+      for (int f = 0; f < vpc; ++f)
+      {
+        std::int64_t v[3];
+        faceOf(e, f, v);
+        faces[fill[v[0]]++] = Face{ v[1], v[2], e * vpc + f };
+      }
     }
   }
   // At most half the element faces are interior: no doubling growth (a 4 M-element mesh's lists
@@ -112,30 +121,34 @@ FaceAdjacency BuildFaces(
   adj.LocalB.reserve(nFaces / 2);
   for (size_t b = 0; b + 1 < bucketStart.size(); ++b)
   {
-    auto first = order.begin() + bucketStart[b], last = order.begin() + bucketStart[b + 1];
-    std::sort(first, last, [&](std::int64_t x, std::int64_t y) {
-      const Face &p = faces[x], &q = faces[y];
-      return std::make_pair(p.v[1], p.v[2]) < std::make_pair(q.v[1], q.v[2]) ||
-        (std::make_pair(p.v[1], p.v[2]) == std::make_pair(q.v[1], q.v[2]) && x < y);
+    Face* first = faces.get() + bucketStart[b];
+    Face* last = faces.get() + bucketStart[b + 1];
+    std::sort(first, last, [](const Face& p, const Face& q) {
+      return p.V1 != q.V1 ? p.V1 < q.V1 : (p.V2 != q.V2 ? p.V2 < q.V2 : p.Id < q.Id);
     });
-    for (auto it = first; it != last;)
+    for (Face* it = first; it != last;)
     {
-      const Face& p = faces[*it];
-      if (it + 1 != last && faces[*(it + 1)].v[1] == p.v[1] && faces[*(it + 1)].v[2] == p.v[2])
+      const Face& p = *it;
+      const std::int64_t pe = p.Id / vpc;
+      const int pl = static_cast<int>(p.Id % vpc);
+      if (it + 1 != last && (it + 1)->V1 == p.V1 && (it + 1)->V2 == p.V2)
       {
-        const Face& q = faces[*(it + 1)];
-        const bool pFirst = p.element < q.element;
-        adj.A.push_back(pFirst ? p.element : q.element);
-        adj.B.push_back(pFirst ? q.element : p.element);
-        adj.LocalA.push_back(static_cast<std::uint8_t>(pFirst ? p.local : q.local));
-        adj.LocalB.push_back(static_cast<std::uint8_t>(pFirst ? q.local : p.local));
-        adj.Measure.push_back(FaceMeasure(P, p.v, fv));
+        const Face& q = *(it + 1);
+        const std::int64_t qe = q.Id / vpc;
+        const int ql = static_cast<int>(q.Id % vpc);
+        const bool pFirst = pe < qe;
+        adj.A.push_back(pFirst ? pe : qe);
+        adj.B.push_back(pFirst ? qe : pe);
+        adj.LocalA.push_back(static_cast<std::uint8_t>(pFirst ? pl : ql));
+        adj.LocalB.push_back(static_cast<std::uint8_t>(pFirst ? ql : pl));
+        const std::int64_t v[3] = { static_cast<std::int64_t>(b), p.V1, p.V2 };
+        adj.Measure.push_back(FaceMeasure(P, v, fv));
         it += 2;
       }
       else
       {
-        adj.HullElement.push_back(p.element);
-        adj.HullFace.push_back(static_cast<std::uint8_t>(p.local));
+        adj.HullElement.push_back(pe);
+        adj.HullFace.push_back(static_cast<std::uint8_t>(pl));
         ++it;
       }
     }
