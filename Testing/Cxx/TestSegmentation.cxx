@@ -1218,6 +1218,42 @@ TEST(VoxelRefinement, TheBandFollowsTheVoxelsAndTheRestKeepsItsElements)
   }
 }
 
+TEST(VoxelRefinement, VoxelGridSigmaIsTheRootMeanSquareOfFaceDifferences)
+{
+  // Two channels on a grid of more than one 2^16-voxel slab, 3D and 2D: sigma against a direct
+  // sum over every face pair, and the same value for any split of the slabs.
+  for (const std::array<int, 3> dims : { std::array<int, 3>{ { 50, 45, 33 } }, std::array<int, 3>{ { 301, 257, 1 } } })
+  {
+    ImageGeometry g;
+    g.Dims = dims;
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-5.f, 5.f);
+    std::vector<float> values(2 * g.Size());
+    for (float& x : values)
+      x = u(rng);
+    double sum = 0.0, pairs = 0.0;
+    for (int k = 0; k < dims[2]; ++k)
+      for (int j = 0; j < dims[1]; ++j)
+        for (int i = 0; i < dims[0]; ++i)
+          for (const std::array<int, 3> d : { std::array<int, 3>{ { 1, 0, 0 } }, std::array<int, 3>{ { 0, 1, 0 } },
+                 std::array<int, 3>{ { 0, 0, 1 } } })
+          {
+            if (!g.Contains(i + d[0], j + d[1], k + d[2]))
+              continue;
+            const std::int64_t a = g.Index(i, j, k), b = g.Index(i + d[0], j + d[1], k + d[2]);
+            for (int c = 0; c < 2; ++c)
+            {
+              const double x = double(values[2 * a + c]) - double(values[2 * b + c]);
+              sum += x * x;
+            }
+            pairs += 1.0;
+          }
+    const double sigma = VoxelGridSigma(values.data(), 2, g, SerialFor());
+    EXPECT_NEAR(sigma, std::sqrt(sum / pairs), 1e-12 * sigma);
+    EXPECT_EQ(VoxelGridSigma(values.data(), 2, g, Chunked), sigma);
+  }
+}
+
 TEST(VoxelRefinement, TwoLabelComponentsCutApartAsOne)
 {
   // Grids with random costs and weights: apart (each its own graph's component), the labels equal

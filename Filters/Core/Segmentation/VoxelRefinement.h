@@ -98,9 +98,11 @@ double VoxelGridSigma(const T* values, int channels, const ImageGeometry& geomet
     for (std::int64_t s = s0; s < s1; ++s)
     {
       const std::int64_t last = std::min(size, (s + 1) * slab);
+      // The voxel's coordinates stepped along, not divided out of its index per voxel.
+      std::array<int, 3> ijk = geometry.Coordinates(s * slab);
+      double sum = 0.0, edges = 0.0;
       for (std::int64_t v = s * slab; v < last; ++v)
       {
-        const std::array<int, 3> ijk = geometry.Coordinates(v);
         for (int d = 0; d < 3; ++d)
         {
           if (ijk[d] + 1 < geometry.Dims[d])
@@ -112,11 +114,22 @@ double VoxelGridSigma(const T* values, int channels, const ImageGeometry& geomet
                 static_cast<double>(values[(v + stride[d]) * channels + c]);
               d2 += x * x;
             }
-            ss[s] += d2;
-            count[s] += 1.0;
+            sum += d2;
+            edges += 1.0;
+          }
+        }
+        if (++ijk[0] == geometry.Dims[0])
+        {
+          ijk[0] = 0;
+          if (++ijk[1] == geometry.Dims[1])
+          {
+            ijk[1] = 0;
+            ++ijk[2];
           }
         }
       }
+      ss[s] = sum;
+      count[s] = edges;
     }
   });
   const double total = std::accumulate(ss.begin(), ss.end(), 0.0), edges = std::accumulate(count.begin(), count.end(), 0.0);
