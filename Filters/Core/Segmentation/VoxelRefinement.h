@@ -140,8 +140,8 @@ double VoxelGridSigma(const T* values, int channels, const ImageGeometry& geomet
 // The exact minimum of a two-label Potts problem (label 1 pays Cost[2i + 1]) by Boykov-Kolmogorov
 // max-flow; returns the energy, throws std::runtime_error when memory runs out. A graph that falls
 // apart into components (a band around separate objects) runs them on two graphs side by side,
-// dealt in order of their first node to the graph with fewer nodes so far; one component of three
-// quarters of the nodes or more (an object's shell) runs alone. The labels are one graph's: a node
+// dealt in order of their first node to the graph with fewer nodes so far; one component of more
+// than three quarters of the nodes (an object's shell) runs alone. The labels are one graph's: a node
 // takes label 1 unless it reaches the sink in the final residual graph, which every maximum flow
 // leaves the same.
 double BinaryPottsCut(const PottsProblem& problem, std::vector<std::uint8_t>& label, const ParallelFor& parallel);
