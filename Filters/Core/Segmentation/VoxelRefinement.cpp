@@ -18,31 +18,8 @@ namespace
 using Clock = std::chrono::steady_clock;
 using Flow = FlowGraph;
 
-// The exact minimum of a two-label Potts problem (label 1 on the source side) on `g`, emptied
-// first; returns the energy.
-double BinaryCut(const PottsProblem& pr, Flow& g, std::vector<std::uint8_t>& label)
-{
-  const std::int64_t n = pr.Nodes;
-  g.reset();
-  g.add_node(static_cast<int>(n));
-  for (std::int64_t i = 0; i < n; ++i)
-  {
-    // A node on the sink side (label 0) pays its source capacity.
-    g.add_tweights(static_cast<int>(i), pr.Cost[2 * i], pr.Cost[2 * i + 1]);
-  }
-  pr.Edges->ForEach([&](std::int64_t e, std::int64_t a, std::int64_t b) {
-    g.add_edge(static_cast<int>(a), static_cast<int>(b), pr.Weight[e], pr.Weight[e]);
-  });
-  const double energy = g.maxflow();
-  label.resize(n);
-  for (std::int64_t i = 0; i < n; ++i)
-  {
-    label[i] = g.what_segment(static_cast<int>(i)) == Flow::SOURCE ? 1 : 0;
-  }
-  return energy;
-}
-
-// BinaryPottsCut on kept graphs.
+// BinaryPottsCut on kept graphs: each graph emptied, then given its nodes' costs and edges in the
+// problem's order (label 1 on the source side); returns the energy.
 double CutOnGraphs(const PottsProblem& pr, std::array<std::unique_ptr<Flow>, 2>& graphs, std::vector<std::uint8_t>& label,
   const ParallelFor& parallel)
 {
@@ -54,50 +31,46 @@ double CutOnGraphs(const PottsProblem& pr, std::array<std::unique_ptr<Flow>, 2>&
   {
     ++size[c];
   }
-  // A kept graph grows as libmaxflow's do; a new one is made for this problem's share.
-  const auto make = [&](std::unique_ptr<Flow>& g, std::int64_t nodes) {
-    if (!g)
-    {
-      const std::int64_t edges = pr.Edges->Size() * nodes / std::max<std::int64_t>(n, 1);
-      g = std::make_unique<Flow>(static_cast<int>(nodes), static_cast<int>(edges), ThrowOutOfMemory);
-    }
-  };
-  if (count < 2 || 4 * *std::max_element(size.begin(), size.end()) > 3 * n)
-  {
-    make(graphs[0], n);
-    return BinaryCut(pr, *graphs[0], label);
-  }
-  std::vector<std::uint8_t> side(count);
+  const bool apart = count > 1 && 4 * *std::max_element(size.begin(), size.end()) <= 3 * n;
+  // Each component's graph (all the first's unless apart), each node's graph and index in it.
+  std::vector<std::uint8_t> side(count, 0);
   std::array<std::int64_t, 2> load{ { 0, 0 } };
-  for (std::int64_t c = 0; c < count; ++c)
+  for (std::int64_t c = 0; c < count && apart; ++c)
   {
     side[c] = load[1] < load[0] ? 1 : 0;
     load[side[c]] += size[c];
   }
-  // Each node's index in its side's graph.
+  std::vector<std::uint8_t> nodeSide(n);
   std::vector<std::int32_t> local(n);
   std::array<std::int32_t, 2> nodes{ { 0, 0 } };
   for (std::int64_t i = 0; i < n; ++i)
   {
-    local[i] = nodes[side[component[i]]]++;
+    nodeSide[i] = side[component[i]];
+    local[i] = nodes[nodeSide[i]]++;
   }
-  make(graphs[0], nodes[0]);
-  make(graphs[1], nodes[1]);
   std::array<double, 2> energy{ { 0.0, 0.0 } };
   label.resize(n);
-  const auto cut = [&](std::int64_t s) {
-    Flow& g = *graphs[s];
+  const auto cut = [&](int s) {
+    // A kept graph grows as libmaxflow's do; a new one is made for this problem's share.
+    std::unique_ptr<Flow>& kept = graphs[s];
+    if (!kept)
+    {
+      const std::int64_t edges = pr.Edges->Size() * nodes[s] / std::max<std::int64_t>(n, 1);
+      kept = std::make_unique<Flow>(nodes[s], static_cast<int>(edges), ThrowOutOfMemory);
+    }
+    Flow& g = *kept;
     g.reset();
     g.add_node(nodes[s]);
     for (std::int64_t i = 0; i < n; ++i)
     {
-      if (side[component[i]] == s)
+      if (nodeSide[i] == s)
       {
+        // A node on the sink side (label 0) pays its source capacity.
         g.add_tweights(local[i], pr.Cost[2 * i], pr.Cost[2 * i + 1]);
       }
     }
     pr.Edges->ForEach([&](std::int64_t e, std::int64_t a, std::int64_t b) {
-      if (side[component[a]] == s)
+      if (nodeSide[a] == s)
       {
         g.add_edge(local[a], local[b], pr.Weight[e], pr.Weight[e]);
       }
@@ -105,12 +78,17 @@ double CutOnGraphs(const PottsProblem& pr, std::array<std::unique_ptr<Flow>, 2>&
     energy[s] = g.maxflow();
     for (std::int64_t i = 0; i < n; ++i)
     {
-      if (side[component[i]] == s)
+      if (nodeSide[i] == s)
       {
         label[i] = g.what_segment(local[i]) == Flow::SOURCE ? 1 : 0;
       }
     }
   };
+  if (!apart)
+  {
+    cut(0);
+    return energy[0];
+  }
   // Out of memory on a worker thread is rethrown on the caller's.
   std::array<std::exception_ptr, 2> error;
   parallel(2, 1, [&](std::int64_t s0, std::int64_t s1) {
@@ -118,7 +96,7 @@ double CutOnGraphs(const PottsProblem& pr, std::array<std::unique_ptr<Flow>, 2>&
     {
       try
       {
-        cut(s);
+        cut(static_cast<int>(s));
       }
       catch (...)
       {
