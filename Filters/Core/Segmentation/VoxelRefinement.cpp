@@ -18,21 +18,28 @@ namespace
 using Clock = std::chrono::steady_clock;
 using Flow = FlowGraph;
 
-// BinaryPottsCut on kept graphs: each graph emptied, then given its nodes' costs and edges in the
-// problem's order (label 1 on the source side); returns the energy.
-double CutOnGraphs(const PottsProblem& pr, std::array<std::unique_ptr<Flow>, 2>& graphs, std::vector<std::uint8_t>& label,
-  const ParallelFor& parallel)
+// A two-label problem's max-flow graphs (label 1 on the source side). Its face-connected components
+// are dealt to two graphs, solved side by side, unless one holds more than three quarters of the
+// nodes (then all lie on the first); each node's graph and id in it; the costs the graphs hold.
+struct BinaryGraphs
 {
-  const std::int64_t n = pr.Nodes;
+  std::array<std::unique_ptr<Flow>, 2> Graph;
+  std::vector<std::uint8_t> Side;
+  std::vector<std::int32_t> Local;
+  std::array<std::int32_t, 2> Nodes{ { 0, 0 } };
+  std::vector<double> Cost; // node i's cost of label 0 at 2 i, of label 1 at 2 i + 1
+};
+
+void DealComponents(std::int64_t n, const GraphEdges& edges, BinaryGraphs& g)
+{
   std::int64_t count = 0;
-  const std::vector<std::int64_t> component = LabelComponents(std::vector<std::uint8_t>(n, 0), *pr.Edges, count);
+  const std::vector<std::int64_t> component = LabelComponents(std::vector<std::uint8_t>(n, 0), edges, count);
   std::vector<std::int64_t> size(count, 0);
   for (std::int64_t c : component)
   {
     ++size[c];
   }
   const bool apart = count > 1 && 4 * *std::max_element(size.begin(), size.end()) <= 3 * n;
-  // Each component's graph (all the first's unless apart), each node's graph and index in it.
   std::vector<std::uint8_t> side(count, 0);
   std::array<std::int64_t, 2> load{ { 0, 0 } };
   for (std::int64_t c = 0; c < count && apart; ++c)
@@ -40,77 +47,112 @@ double CutOnGraphs(const PottsProblem& pr, std::array<std::unique_ptr<Flow>, 2>&
     side[c] = load[1] < load[0] ? 1 : 0;
     load[side[c]] += size[c];
   }
-  std::vector<std::uint8_t> nodeSide(n);
-  std::vector<std::int32_t> local(n);
-  std::array<std::int32_t, 2> nodes{ { 0, 0 } };
+  g.Side.resize(n);
+  g.Local.resize(n);
+  g.Nodes = { { 0, 0 } };
   for (std::int64_t i = 0; i < n; ++i)
   {
-    nodeSide[i] = side[component[i]];
-    local[i] = nodes[nodeSide[i]]++;
+    g.Side[i] = side[component[i]];
+    g.Local[i] = g.Nodes[g.Side[i]]++;
   }
+}
+
+// The max-flows of `cost` (node i's label 0 at 2 i, label 1 at 2 i + 1): on fresh graphs of the
+// edges' weights, or (reuse) on the kept graphs, their terminal capacities moved to `cost` and each
+// flow run on from the last (Kohli & Torr; the edges are unchanged). A node takes label 1 unless it
+// reaches the sink in the final residual graph, which every maximum flow leaves the same. Returns
+// the flow.
+double SolveGraphs(const std::vector<double>& cost, const GraphEdges& edges, const std::vector<double>& weight,
+  BinaryGraphs& g, bool reuse, std::vector<std::uint8_t>& label, const ParallelFor& parallel)
+{
+  const std::int64_t n = static_cast<std::int64_t>(g.Side.size());
   std::array<double, 2> energy{ { 0.0, 0.0 } };
   label.resize(n);
   const auto cut = [&](int s) {
-    // A kept graph grows as libmaxflow's do; a new one is made for this problem's share.
-    std::unique_ptr<Flow>& kept = graphs[s];
-    if (!kept)
+    std::unique_ptr<Flow>& kept = g.Graph[s];
+    if (!reuse)
     {
-      const std::int64_t edges = pr.Edges->Size() * nodes[s] / std::max<std::int64_t>(n, 1);
-      kept = std::make_unique<Flow>(nodes[s], static_cast<int>(edges), ThrowOutOfMemory);
-    }
-    Flow& g = *kept;
-    g.reset();
-    g.add_node(nodes[s]);
-    for (std::int64_t i = 0; i < n; ++i)
-    {
-      if (nodeSide[i] == s)
+      // A kept graph grows as libmaxflow's do; a new one is made for this problem's share.
+      if (!kept)
       {
-        // A node on the sink side (label 0) pays its source capacity.
-        g.add_tweights(local[i], pr.Cost[2 * i], pr.Cost[2 * i + 1]);
+        const std::int64_t m = edges.Size() * g.Nodes[s] / std::max<std::int64_t>(n, 1);
+        kept = std::make_unique<Flow>(g.Nodes[s], static_cast<int>(m), ThrowOutOfMemory);
+      }
+      kept->reset();
+      kept->add_node(g.Nodes[s]);
+      for (std::int64_t i = 0; i < n; ++i)
+      {
+        if (g.Side[i] == s)
+        {
+          // A node on the sink side (label 0) pays its source capacity.
+          kept->add_tweights(g.Local[i], cost[2 * i], cost[2 * i + 1]);
+        }
+      }
+      edges.ForEach([&](std::int64_t e, std::int64_t a, std::int64_t b) {
+        if (g.Side[a] == s)
+        {
+          kept->add_edge(g.Local[a], g.Local[b], weight[e], weight[e]);
+        }
+      });
+    }
+    else
+    {
+      for (std::int64_t i = 0; i < n; ++i)
+      {
+        const double ds = cost[2 * i] - g.Cost[2 * i], dt = cost[2 * i + 1] - g.Cost[2 * i + 1];
+        if (g.Side[i] == s && (ds != 0.0 || dt != 0.0))
+        {
+          // Only a node whose terminal residual changes sign (or leaves or reaches 0) needs its
+          // search tree redone.
+          const double before = kept->get_trcap(g.Local[i]);
+          kept->add_tweights(g.Local[i], ds, dt);
+          const double after = kept->get_trcap(g.Local[i]);
+          if ((before > 0) != (after > 0) || (before < 0) != (after < 0))
+          {
+            kept->mark_node(g.Local[i]);
+          }
+        }
       }
     }
-    pr.Edges->ForEach([&](std::int64_t e, std::int64_t a, std::int64_t b) {
-      if (nodeSide[a] == s)
-      {
-        g.add_edge(local[a], local[b], pr.Weight[e], pr.Weight[e]);
-      }
-    });
-    energy[s] = g.maxflow();
+    energy[s] = kept->maxflow(reuse);
     for (std::int64_t i = 0; i < n; ++i)
     {
-      if (nodeSide[i] == s)
+      if (g.Side[i] == s)
       {
-        label[i] = g.what_segment(local[i]) == Flow::SOURCE ? 1 : 0;
+        label[i] = kept->what_segment(g.Local[i]) == Flow::SOURCE ? 1 : 0;
       }
     }
   };
-  if (!apart)
+  if (g.Nodes[1] == 0)
   {
     cut(0);
-    return energy[0];
   }
-  // Out of memory on a worker thread is rethrown on the caller's.
-  std::array<std::exception_ptr, 2> error;
-  parallel(2, 1, [&](std::int64_t s0, std::int64_t s1) {
-    for (std::int64_t s = s0; s < s1; ++s)
-    {
-      try
-      {
-        cut(static_cast<int>(s));
-      }
-      catch (...)
-      {
-        error[s] = std::current_exception();
-      }
-    }
-  });
-  for (const std::exception_ptr& e : error)
+  else
   {
-    if (e)
+    // Out of memory on a worker thread is rethrown on the caller's.
+    std::array<std::exception_ptr, 2> error;
+    parallel(2, 1, [&](std::int64_t s0, std::int64_t s1) {
+      for (std::int64_t s = s0; s < s1; ++s)
+      {
+        try
+        {
+          cut(static_cast<int>(s));
+        }
+        catch (...)
+        {
+          error[s] = std::current_exception();
+        }
+      }
+    });
+    for (const std::exception_ptr& e : error)
     {
-      std::rethrow_exception(e);
+      if (e)
+      {
+        std::rethrow_exception(e);
+      }
     }
   }
+  g.Cost = cost;
   return energy[0] + energy[1];
 }
 
@@ -253,15 +295,21 @@ struct Band
   std::vector<std::int64_t> Voxel;
   std::vector<std::uint64_t> Around; // per voxel: the labels of its neighbours outside the band (bit l, l < 64)
   std::vector<std::int32_t>& Index;  // per image voxel: its band index, -1 outside the band
+  // A two-label refinement's kept domain: the voxels held at their elements' labels (empty: none),
+  // and the index map left as it is for the next refinement.
+  std::vector<std::uint8_t> Held;
+  bool KeepIndex = false;
   std::int64_t Stride[3];
   int Axes;
 
-  Band(const VoxelRefinementProblem& p, std::vector<std::int64_t> voxels, std::vector<std::int32_t>& index)
+  Band(const VoxelRefinementProblem& p, std::vector<std::int64_t> voxels, std::vector<std::int32_t>& index,
+    bool keepIndex = false)
     : P(p)
     , G(p.Mesh->Geometry())
     , Voxel(std::move(voxels))
     , Around(Voxel.size(), 0)
     , Index(index)
+    , KeepIndex(keepIndex)
     , Stride{ 1, G.Dims[0], G.SliceStride() }
     , Axes(G.Is2D() ? 2 : 3)
   {
@@ -274,12 +322,12 @@ struct Band
       this->Index[this->Voxel[i]] = static_cast<std::int32_t>(i);
     }
   }
-  // The index map is left as it was found: -1 everywhere.
+  // The index map is left as it was found: -1 everywhere (unless kept).
   ~Band()
   {
-    for (std::int64_t v : this->Voxel)
+    for (std::size_t i = 0; i < this->Voxel.size() && !this->KeepIndex; ++i)
     {
-      this->Index[v] = -1;
+      this->Index[this->Voxel[i]] = -1;
     }
   }
   Band(const Band&) = delete;
@@ -292,6 +340,13 @@ struct Band
   }
   // The band index of voxel u, -1 outside the band.
   std::int64_t Find(std::int64_t u) const { return this->Index[u]; }
+  bool IsHeld(std::int64_t i) const { return !this->Held.empty() && this->Held[i]; }
+  // Whether voxel u is refined (in the band, not held).
+  bool Free(std::int64_t u) const
+  {
+    const std::int64_t j = this->Index[u];
+    return j >= 0 && !this->IsHeld(j);
+  }
   // f(u, forward) for every face neighbour u of voxel v; `border` is set when v lies on the image's border.
   template <typename F>
   void Neighbours(std::int64_t v, F&& f, bool* border = nullptr) const
@@ -319,28 +374,29 @@ struct Band
   }
 };
 
-// The band's Potts problem: costs from P.Cost, a label no element near the voxel's has priced out,
-// and per voxel face an edge to a band voxel or its weight on every label but its neighbour's
-// outside the band. Fixed chunks of voxels in parallel, their edges joined in chunk order.
-void BuildProblem(Band& band, const std::vector<std::uint64_t>& near, PottsProblem& pr, std::vector<std::int64_t>& a,
-  std::vector<std::int64_t>& b)
+// The band's voxel faces with their Potts weights, and per voxel its faces to voxels outside the
+// band (neighbour, weight) in compressed rows: they depend on the image alone. Fixed chunks of
+// voxels in parallel, joined in chunk order.
+struct BandFaces
+{
+  std::vector<std::int64_t> A, B, OutFirst, OutVoxel;
+  std::vector<double> W, OutWeight;
+};
+
+void BuildBandFaces(const Band& band, BandFaces& f)
 {
   const VoxelRefinementProblem& p = band.P;
-  const int L = p.Labels;
   const std::int64_t nb = band.Size();
-  pr.Nodes = nb;
-  pr.Labels = L;
-  pr.Cost.resize(nb * L);
   const double inv2s2 = 1.0 / (2.0 * p.Sigma * p.Sigma);
-  constexpr double excluded = 1e9;
   constexpr std::int64_t chunk = 8192;
   const std::int64_t chunks = (nb + chunk - 1) / chunk;
   struct Part
   {
-    std::vector<std::int64_t> A, B;
-    std::vector<double> W;
+    std::vector<std::int64_t> A, B, OutVoxel;
+    std::vector<double> W, OutWeight;
   };
   std::vector<Part> parts(chunks);
+  f.OutFirst.assign(nb + 1, 0);
   p.Parallel(chunks, 1, [&](std::int64_t c0, std::int64_t c1) {
     for (std::int64_t c = c0; c < c1; ++c)
     {
@@ -348,13 +404,7 @@ void BuildProblem(Band& band, const std::vector<std::uint64_t>& near, PottsProbl
       const std::int64_t last = std::min(nb, (c + 1) * chunk);
       for (std::int64_t i = c * chunk; i < last; ++i)
       {
-        const std::int64_t v = band.Voxel[i], e = (*p.Owner)[v];
-        double* cost = &pr.Cost[i * L];
-        p.Cost(v, e, cost);
-        for (int l = 0; l < L && L > 2; ++l)
-        {
-          cost[l] += ((near[e] >> (l & 63)) & 1u) ? 0.0 : excluded;
-        }
+        const std::int64_t v = band.Voxel[i];
         band.Neighbours(v, [&](std::int64_t u, bool) {
           const std::int64_t j = band.Find(u);
           if (j >= 0 && j < i)
@@ -370,22 +420,72 @@ void BuildProblem(Band& band, const std::vector<std::uint64_t>& near, PottsProbl
             part.W.push_back(w);
             return;
           }
-          const std::uint8_t held = band.ElementLabel(u);
-          band.Around[i] |= held < 64 ? std::uint64_t(1) << held : 0;
-          for (int l = 0; l < L; ++l)
-          {
-            cost[l] += l == held ? 0.0 : w;
-          }
+          part.OutVoxel.push_back(u);
+          part.OutWeight.push_back(w);
+          ++f.OutFirst[i + 1];
         });
       }
     }
   });
+  f.A.clear();
+  f.B.clear();
+  f.W.clear();
+  f.OutVoxel.clear();
+  f.OutWeight.clear();
   for (Part& part : parts)
   {
-    a.insert(a.end(), part.A.begin(), part.A.end());
-    b.insert(b.end(), part.B.begin(), part.B.end());
-    pr.Weight.insert(pr.Weight.end(), part.W.begin(), part.W.end());
+    f.A.insert(f.A.end(), part.A.begin(), part.A.end());
+    f.B.insert(f.B.end(), part.B.begin(), part.B.end());
+    f.W.insert(f.W.end(), part.W.begin(), part.W.end());
+    f.OutVoxel.insert(f.OutVoxel.end(), part.OutVoxel.begin(), part.OutVoxel.end());
+    f.OutWeight.insert(f.OutWeight.end(), part.OutWeight.begin(), part.OutWeight.end());
   }
+  std::partial_sum(f.OutFirst.begin(), f.OutFirst.end(), f.OutFirst.begin());
+}
+
+// Each band voxel's cost of every label (voxel i's label l at i * Labels + l): P.Cost, a label no
+// element near its element's has priced out, then the weight of each face to a voxel outside the
+// band whose element's label differs (those labels recorded in Around). A held voxel (a binary
+// refinement's kept domain) pays 0 for its element's label and more than all its faces' weights
+// (each at most 1) for the other. Fixed chunks of voxels in parallel.
+void BandCosts(Band& band, const BandFaces& f, const std::vector<std::uint64_t>& near, std::vector<double>& cost)
+{
+  const VoxelRefinementProblem& p = band.P;
+  const int L = p.Labels;
+  const std::int64_t nb = band.Size();
+  cost.resize(nb * L);
+  const double hold = 2.0 * band.Axes + 1.0;
+  constexpr double excluded = 1e9;
+  constexpr std::int64_t chunk = 8192;
+  p.Parallel((nb + chunk - 1) / chunk, 1, [&](std::int64_t c0, std::int64_t c1) {
+    for (std::int64_t i = c0 * chunk; i < std::min(nb, c1 * chunk); ++i)
+    {
+      const std::int64_t v = band.Voxel[i], e = (*p.Owner)[v];
+      double* c = &cost[i * L];
+      band.Around[i] = 0;
+      if (band.IsHeld(i))
+      {
+        const std::uint8_t held = band.ElementLabel(v);
+        c[held] = 0.0;
+        c[1 - held] = hold;
+        continue;
+      }
+      p.Cost(v, e, c);
+      for (int l = 0; l < L && L > 2; ++l)
+      {
+        c[l] += ((near[e] >> (l & 63)) & 1u) ? 0.0 : excluded;
+      }
+      for (std::int64_t k = f.OutFirst[i]; k < f.OutFirst[i + 1]; ++k)
+      {
+        const std::uint8_t held = band.ElementLabel(f.OutVoxel[k]);
+        band.Around[i] |= held < 64 ? std::uint64_t(1) << held : 0;
+        for (int l = 0; l < L; ++l)
+        {
+          c[l] += l == held ? 0.0 : f.OutWeight[k];
+        }
+      }
+    }
+  });
 }
 
 // The cut's connectivity rule on the refined voxels: a piece of the band (voxels of one label,
@@ -421,7 +521,7 @@ void VoxelConnectivity(const Band& band, const GraphEdges& edges, std::vector<st
   for (std::int64_t i = 0; i < nb; ++i)
   {
     // Fill Holes keeps every object piece.
-    bool keep = ((band.Around[i] >> x[i]) & 1u) || (x[i] != 0 && p.Connectivity == Connectivity::FillHoles);
+    bool keep = band.IsHeld(i) || ((band.Around[i] >> x[i]) & 1u) || (x[i] != 0 && p.Connectivity == Connectivity::FillHoles);
     if (!keep && x[i] == 0)
     {
       band.Neighbours(band.Voxel[i], [](std::int64_t, bool) {}, &keep);
@@ -490,7 +590,7 @@ void LoneVoxelsAround(const Band& band, const std::vector<std::uint8_t>& x, std:
     if (x[i] != before)
     {
       band.Neighbours(band.Voxel[i], [&](std::int64_t u, bool) {
-        if (band.ElementLabel(u) == before && band.Find(u) < 0)
+        if (band.ElementLabel(u) == before && !band.Free(u))
         {
           halo.push_back(u);
         }
@@ -591,8 +691,15 @@ std::vector<double> ComponentChanges(const VoxelRefinementProblem& p, const Voxe
 
 struct VoxelRefinementCache::State
 {
-  std::vector<std::int32_t> Index; // per image voxel: -1 between refinements
-  std::array<std::unique_ptr<Flow>, 2> Graphs;
+  std::vector<std::int32_t> Index; // per image voxel: its index in the kept domain, else -1
+  // Two labels: the kept domain (its voxels and elements), its faces, its max-flow graphs holding the
+  // last flow, and the sigma of its weights.
+  std::vector<std::int64_t> Domain;
+  std::vector<std::uint8_t> DomainElement;
+  BandFaces Faces;
+  BinaryGraphs Binary;
+  double Sigma = 0.0;
+  bool Solved = false;
   ExpansionWorkspace Expansion;
 };
 VoxelRefinementCache::VoxelRefinementCache() = default;
@@ -603,6 +710,131 @@ void VoxelRefinementCache::Clear()
 {
   this->Kept.reset();
 }
+
+namespace
+{
+// The index map back to -1 everywhere, the kept domain gone.
+void DropDomain(VoxelRefinementCache::State& st)
+{
+  for (std::int64_t v : st.Domain)
+  {
+    st.Index[v] = -1;
+  }
+  st.Domain.clear();
+  st.DomainElement.clear();
+  st.Solved = false;
+}
+
+// The refinement's last steps on the band's labels x: the connectivity rule, the lone voxels around,
+// the voxels whose label differs from their element's, the components' changes.
+void Finish(const VoxelRefinementProblem& p, const Band& band, const GraphEdges& edges, std::vector<std::uint8_t>& x,
+  const std::vector<std::uint8_t>& bandElement, VoxelRefinementResult& r)
+{
+  VoxelConnectivity(band, edges, x);
+  std::vector<std::int64_t> loneVoxel;
+  std::vector<std::uint8_t> loneLabel;
+  LoneVoxelsAround(band, x, loneVoxel, loneLabel);
+  for (std::int64_t i = 0; i < band.Size(); ++i)
+  {
+    if (x[i] != band.ElementLabel(band.Voxel[i]))
+    {
+      r.Voxel.push_back(band.Voxel[i]);
+      r.Label.push_back(x[i]);
+    }
+  }
+  // The lone voxels lie outside the band: no voxel twice.
+  r.Voxel.insert(r.Voxel.end(), loneVoxel.begin(), loneVoxel.end());
+  r.Label.insert(r.Label.end(), loneLabel.begin(), loneLabel.end());
+  if (p.Component && p.Labels == 2 && p.Component->size() == p.Label->size() && !p.Component->empty())
+  {
+    r.ComponentChange = ComponentChanges(p, r, bandElement);
+  }
+}
+
+// Two labels: one exact max-flow over the kept domain (State), built afresh when the band leaves
+// it (or its weights changed), else its graphs' flow run on with the new costs.
+void RefineTwoLabels(const VoxelRefinementProblem& p, const ProgressFunction& progress, VoxelRefinementCache::State& st,
+  const std::vector<std::uint8_t>& bandElement, VoxelRefinementResult& r)
+{
+  const std::int64_t n = static_cast<std::int64_t>(bandElement.size());
+  const bool same = st.Solved && st.Sigma == p.Sigma && static_cast<std::int64_t>(st.DomainElement.size()) == n;
+  bool inside = same;
+  std::int64_t band = 0, joined = 0;
+  for (std::int64_t e = 0; e < n; ++e)
+  {
+    band += bandElement[e];
+    joined += bandElement[e] || (same && st.DomainElement[e]);
+    inside = inside && (!bandElement[e] || st.DomainElement[e]);
+  }
+  if (!inside)
+  {
+    // A band that differs from the domain in a few elements (a seed moved back and forth) joins it,
+    // and the next such edit stays inside; one that moved further (a seed where the result was wrong)
+    // replaces it, as a larger domain would make every such edit slower.
+    std::vector<std::uint8_t> element = bandElement;
+    for (std::int64_t e = 0; e < n && same && 100 * joined <= 101 * band; ++e)
+    {
+      element[e] = element[e] || st.DomainElement[e];
+    }
+    DropDomain(st);
+    st.Domain = BandVoxels(*p.Mesh, *p.Owner, element, p.Parallel);
+    st.DomainElement = std::move(element);
+  }
+  Band domain(p, st.Domain, st.Index, true);
+  domain.Held.resize(domain.Size());
+  for (std::int64_t i = 0; i < domain.Size(); ++i)
+  {
+    domain.Held[i] = !bandElement[(*p.Owner)[domain.Voxel[i]]];
+    r.BandVoxels += !domain.Held[i];
+  }
+  const bool held = r.BandVoxels < domain.Size();
+  if (!progress(0.2))
+  {
+    r.Aborted = true;
+    return;
+  }
+  if (domain.Size() == 0)
+  {
+    return;
+  }
+  if (!inside)
+  {
+    BuildBandFaces(domain, st.Faces);
+  }
+  const GraphEdges edges(st.Faces.A, st.Faces.B);
+  std::vector<double> cost;
+  BandCosts(domain, st.Faces, {}, cost);
+  if (!progress(0.4))
+  {
+    r.Aborted = true;
+    return;
+  }
+  std::vector<std::uint8_t> x;
+  try
+  {
+    if (!inside)
+    {
+      DealComponents(domain.Size(), edges, st.Binary);
+    }
+    st.Solved = false;
+    r.Energy = SolveGraphs(cost, edges, st.Faces.W, st.Binary, inside, x, p.Parallel);
+    st.Solved = true;
+    st.Sigma = p.Sigma;
+  }
+  catch (const std::exception&)
+  {
+    r.Error = "not enough memory for the voxel refinement's max-flow (" + std::to_string(domain.Size()) + " voxels).";
+    return;
+  }
+  // The flow holds the faces between held voxels of two labels, which the band's energy does not.
+  for (std::size_t e = 0; e < st.Faces.A.size() && held; ++e)
+  {
+    const std::int64_t i = st.Faces.A[e], j = st.Faces.B[e];
+    r.Energy -= domain.Held[i] && domain.Held[j] && x[i] != x[j] ? st.Faces.W[e] : 0.0;
+  }
+  Finish(p, domain, edges, x, bandElement, r);
+}
+} // namespace
 
 VoxelRefinementResult RefineOnVoxels(const VoxelRefinementProblem& p, const ProgressFunction& progress,
   VoxelRefinementCache* cache)
@@ -623,10 +855,24 @@ VoxelRefinementResult RefineOnVoxels(const VoxelRefinementProblem& p, const Prog
     r.Error = "the voxel refinement's inputs do not match the mesh.";
     return r;
   }
+  VoxelRefinementCache::State& st = *kept.Kept;
+  if (static_cast<std::int64_t>(st.Index.size()) != p.Mesh->Geometry().Size())
+  {
+    st.Domain.clear();
+    st.Solved = false;
+    AssignFresh(st.Index, static_cast<std::size_t>(p.Mesh->Geometry().Size()), std::int32_t(-1));
+  }
   std::vector<std::uint8_t> bandElement;
   std::vector<std::uint64_t> near;
   BandElements(p, *p.Mesh->SharedFaces(), bandElement, near);
-  Band band(p, BandVoxels(*p.Mesh, *p.Owner, bandElement, p.Parallel), kept.Kept->Index);
+  if (p.Labels == 2)
+  {
+    RefineTwoLabels(p, progress, st, bandElement, r);
+    r.Seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    return r;
+  }
+  DropDomain(st);
+  Band band(p, BandVoxels(*p.Mesh, *p.Owner, bandElement, p.Parallel), st.Index);
   const std::int64_t nb = r.BandVoxels = band.Size();
   if (!progress(0.2))
   {
@@ -638,75 +884,45 @@ VoxelRefinementResult RefineOnVoxels(const VoxelRefinementProblem& p, const Prog
     r.Seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     return r;
   }
+  BandFaces faces;
+  BuildBandFaces(band, faces);
   PottsProblem pr;
-  std::vector<std::int64_t> a, b;
-  BuildProblem(band, near, pr, a, b);
-  const GraphEdges edges = GraphEdges::Owned(std::move(a), std::move(b));
+  pr.Nodes = nb;
+  pr.Labels = p.Labels;
+  BandCosts(band, faces, near, pr.Cost);
+  pr.Weight = std::move(faces.W);
+  const GraphEdges edges = GraphEdges::Owned(std::move(faces.A), std::move(faces.B));
   pr.Edges = &edges;
   if (!progress(0.4))
   {
     r.Aborted = true;
     return r;
   }
-  // Two labels: one exact max-flow (source = label 1). More: alpha-expansion from the elements' labels.
-  ExpansionResult x;
-  if (p.Labels == 2)
-  {
-    try
-    {
-      x.Energy = CutOnGraphs(pr, kept.Kept->Graphs, x.Label, p.Parallel);
-    }
-    catch (const std::exception&)
-    {
-      r.Error = "not enough memory for the voxel refinement's max-flow (" + std::to_string(nb) + " voxels).";
-      return r;
-    }
-  }
-  else
-  {
-    std::vector<std::uint8_t> start(nb);
-    for (std::int64_t i = 0; i < nb; ++i)
-    {
-      start[i] = band.ElementLabel(band.Voxel[i]);
-    }
-    // One cycle over the labels: from the elements' labels a second moved no case's Dice by more
-    // than 0.001 and took as long again (docs/multilabel.md).
-    x = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.4, 1.0), 1, nullptr, p.Parallel, &kept.Kept->Expansion);
-    if (!x.Error.empty() || x.Aborted)
-    {
-      r.Error = x.Error;
-      r.Aborted = x.Aborted;
-      return r;
-    }
-  }
-  r.Energy = x.Energy;
-  VoxelConnectivity(band, edges, x.Label);
-  std::vector<std::int64_t> loneVoxel;
-  std::vector<std::uint8_t> loneLabel;
-  LoneVoxelsAround(band, x.Label, loneVoxel, loneLabel);
+  // Alpha-expansion from the elements' labels. One cycle over the labels: from the elements' labels a
+  // second moved no case's Dice by more than 0.001 and took as long again (docs/multilabel.md).
+  std::vector<std::uint8_t> start(nb);
   for (std::int64_t i = 0; i < nb; ++i)
   {
-    if (x.Label[i] != band.ElementLabel(band.Voxel[i]))
-    {
-      r.Voxel.push_back(band.Voxel[i]);
-      r.Label.push_back(x.Label[i]);
-    }
+    start[i] = band.ElementLabel(band.Voxel[i]);
   }
-  // The lone voxels lie outside the band: no voxel twice.
-  r.Voxel.insert(r.Voxel.end(), loneVoxel.begin(), loneVoxel.end());
-  r.Label.insert(r.Label.end(), loneLabel.begin(), loneLabel.end());
-  if (p.Component && p.Labels == 2 && p.Component->size() == p.Label->size() && !p.Component->empty())
+  ExpansionResult x = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.4, 1.0), 1, nullptr, p.Parallel, &st.Expansion);
+  if (!x.Error.empty() || x.Aborted)
   {
-    r.ComponentChange = ComponentChanges(p, r, bandElement);
+    r.Error = x.Error;
+    r.Aborted = x.Aborted;
+    return r;
   }
+  r.Energy = x.Energy;
+  Finish(p, band, edges, x.Label, bandElement, r);
   r.Seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return r;
 }
 
 double BinaryPottsCut(const PottsProblem& problem, std::vector<std::uint8_t>& label, const ParallelFor& parallel)
 {
-  std::array<std::unique_ptr<Flow>, 2> graphs;
-  return CutOnGraphs(problem, graphs, label, parallel);
+  BinaryGraphs graphs;
+  DealComponents(problem.Nodes, *problem.Edges, graphs);
+  return SolveGraphs(problem.Cost, *problem.Edges, problem.Weight, graphs, false, label, parallel);
 }
 
 void ApplyRefinement(const VoxelRefinementResult& refinement, std::uint8_t* labels)

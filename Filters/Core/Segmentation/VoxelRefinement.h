@@ -66,9 +66,15 @@ struct VoxelRefinementResult
   bool Aborted = false;
 };
 
-// What a refinement keeps for the next (a seed edit's re-cut): a map of the image's voxels to the
-// band (4 bytes per voxel) and the max-flow graph's (or the expansion's) memory, so that neither is
-// allocated afresh.
+// What a refinement keeps for the next (a seed edit's re-cut) of one mesh and image: a map of the
+// image's voxels to the band (4 bytes per voxel) and the expansion's memory; with two labels, the
+// domain its max-flow ran on (the band's voxels, and those of elements in an earlier band, held at
+// their elements' labels), its voxel faces and weights, and the max-flow graphs with their flow.
+// While the band stays inside the domain (a seed moved, then moved back), the next refinement moves
+// the terminal capacities and runs the flow on (Kohli & Torr) instead of building it again; its
+// labels are a fresh refinement's, as a node's label depends only on the maximum flow's residual
+// graph. A band that leaves the domain joins it while the two stay within 1.01 times the band's
+// elements, else replaces it.
 class VoxelRefinementCache
 {
 public:
