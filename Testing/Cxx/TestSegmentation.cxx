@@ -1318,63 +1318,78 @@ TEST(VoxelRefinement, TwoLabelComponentsCutApartAsOne)
 TEST(VoxelRefinement, AKeptDomainGivesWhatAFreshRefinementGives)
 {
   // One cache through a chain of edits, each against a fresh refinement: the elements' labels change
-  // (the band leaves the kept domain, then comes back inside it), the voxels' costs change (the kept
-  // flow runs on), a seed's element is held, the rings shrink (voxels of the domain held), sigma
-  // changes (new weights); noisy costs make pieces for the connectivity rule. Each result labels
-  // every voxel as the fresh one does, with the same band, energy and components' changes.
-  RefinementCase c(false);
-  const std::vector<std::uint8_t> truthElement = c.Element;
-  const FaceAdjacency& faces = *c.Mesh.SharedFaces();
-  // Object elements beside the background, and their object neighbours: a two-element-deep bite.
-  std::vector<std::uint8_t> bitten = c.Element;
-  for (std::size_t k = 0; k < faces.A.size(); ++k)
-    for (const auto& [a, b] : { std::make_pair(faces.A[k], faces.B[k]), std::make_pair(faces.B[k], faces.A[k]) })
-      if (truthElement[a] == 1 && truthElement[b] == 0 && a % 3 == 0)
-        bitten[a] = 0;
-  ASSERT_NE(bitten, truthElement);
-  std::vector<std::int64_t> component(c.Element.size(), 0);
-  int edit = 0;
-  VoxelRefinementProblem p = c.Problem(2);
-  p.Sigma = 12.0;
-  p.Rings = 2;
-  p.Connectivity = Connectivity::FillHoles;
-  p.Component = &component;
-  p.Cost = [&](std::int64_t v, std::int64_t, double* cost) {
-    // A deterministic noise per voxel and edit, against the truth on a few voxels.
-    const std::uint64_t h = (static_cast<std::uint64_t>(v) * 2654435761u + static_cast<std::uint64_t>(edit) * 40503u) % 1000u;
-    const double flip = h < 60 ? 1.0 : 0.0;
-    cost[0] = (c.Truth[v] == 1) != (flip > 0.0) ? 1.5 + 0.001 * static_cast<double>(h) : 0.001 * static_cast<double>(h % 7);
-    cost[1] = (c.Truth[v] == 0) != (flip > 0.0) ? 1.5 + 0.0005 * static_cast<double>(h) : 0.001 * static_cast<double>(h % 5);
-  };
-  VoxelRefinementCache cache;
-  const std::vector<std::function<void()>> edits = {
-    [] {},                                        // the first refinement builds the domain
-    [&] { c.Element = bitten; },                  // the band leaves it
-    [&] { c.Element = truthElement; },            // and comes back inside the joined domain
-    [&] { ++edit; },                              // new costs on the kept graph
-    [&] { c.Element = bitten; ++edit; },          // inside again, both changed
-    [&] { p.Fixed.assign(c.Element.size(), 0); p.Fixed[faces.A[0]] = 1; p.Fixed[faces.B[0]] = 1; },
-    [&] { p.Rings = 1; c.Element = truthElement; }, // a narrower band: domain voxels held
-    [&] { p.Sigma = 6.0; },                       // new weights: a new domain
-    [&] { p.Rings = 2; ++edit; },
-  };
-  int relabelled = 0;
-  for (std::size_t step = 0; step < edits.size(); ++step)
+  // (the band leaves the kept domain, which grows, or comes back inside it), the voxels' costs change
+  // (the kept flow runs on), a seed's element is held, the rings shrink (voxels of the domain held),
+  // sigma changes (new weights); noisy costs make pieces for the connectivity rule. One object (one
+  // graph, which grows) and two (the band's components on two graphs, built again). Each result
+  // labels every voxel as the fresh one does, with the same band, energy and components' changes.
+  for (const bool two : { false, true })
   {
-    edits[step]();
-    for (std::size_t e = 0; e < component.size(); ++e)
-      component[e] = c.Element[e] ? 0 : -1;
-    const VoxelRefinementResult kept = RefineOnVoxels(p, NoProgress(), &cache);
-    const VoxelRefinementResult fresh = RefineOnVoxels(p);
-    ASSERT_TRUE(kept.Error.empty() && fresh.Error.empty()) << kept.Error << fresh.Error;
-    EXPECT_EQ(c.Labelled(kept), c.Labelled(fresh)) << "step " << step;
-    EXPECT_EQ(kept.BandVoxels, fresh.BandVoxels) << "step " << step;
-    EXPECT_EQ(kept.Voxel.size(), fresh.Voxel.size()) << "step " << step;
-    EXPECT_NEAR(kept.Energy, fresh.Energy, 1e-9 * (1.0 + fresh.Energy)) << "step " << step;
-    EXPECT_EQ(kept.ComponentChange, fresh.ComponentChange) << "step " << step;
-    relabelled += fresh.Voxel.size() > 10;
+    RefinementCase c(two);
+    for (std::uint8_t& l : c.Element)
+      l = l ? 1 : 0;
+    const std::vector<std::uint8_t> truthElement = c.Element;
+    const FaceAdjacency& faces = *c.Mesh.SharedFaces();
+    // Every third object element beside the background goes: a bite into the object.
+    std::vector<std::uint8_t> bitten = c.Element;
+    for (std::size_t k = 0; k < faces.A.size(); ++k)
+      for (const auto& [a, b] : { std::make_pair(faces.A[k], faces.B[k]), std::make_pair(faces.B[k], faces.A[k]) })
+        if (truthElement[a] == 1 && truthElement[b] == 0 && a % 3 == 0)
+          bitten[a] = 0;
+    ASSERT_NE(bitten, truthElement);
+    std::vector<std::int64_t> component(c.Element.size(), 0);
+    int edit = 0;
+    VoxelRefinementProblem p = c.Problem(2);
+    // Weights that vary along each object too (0.3-1 within, 0 across its edge).
+    p.Distance2 = [&c](std::int64_t a, std::int64_t b) {
+      const double d = double(c.Value[a]) - double(c.Value[b]);
+      const std::uint64_t h = (static_cast<std::uint64_t>(std::min(a, b)) * 7919u + static_cast<std::uint64_t>(std::max(a, b)) * 104729u) % 97u;
+      return d * d + 0.2 * static_cast<double>(h);
+    };
+    p.Sigma = 3.0;
+    p.Rings = 2;
+    p.Connectivity = Connectivity::FillHoles;
+    p.Component = &component;
+    p.Cost = [&](std::int64_t v, std::int64_t, double* cost) {
+      // A deterministic noise per voxel and edit, against the truth on a few voxels.
+      const std::uint64_t h = (static_cast<std::uint64_t>(v) * 2654435761u + static_cast<std::uint64_t>(edit) * 40503u) % 1000u;
+      const bool object = (c.Truth[v] != 0) != (h < 150);
+      cost[0] = object ? 1.5 + 0.001 * static_cast<double>(h) : 0.001 * static_cast<double>(h % 7);
+      cost[1] = !object ? 1.5 + 0.0005 * static_cast<double>(h) : 0.001 * static_cast<double>(h % 5);
+    };
+    VoxelRefinementCache cache;
+    const std::vector<std::function<void()>> edits = {
+      [] {},                                          // the first refinement builds the domain
+      [&] { c.Element = bitten; },                    // the band leaves it
+      [&] { c.Element = truthElement; },              // and comes back inside
+      [&] { ++edit; },                                // new costs on the kept graph
+      [&] { c.Element = bitten; ++edit; },            // inside again, both changed
+      [&] { p.Fixed.assign(c.Element.size(), 0); p.Fixed[faces.A[0]] = 1; p.Fixed[faces.B[0]] = 1; },
+      [&] { p.Rings = 1; c.Element = truthElement; }, // a narrower band: domain voxels held
+      [&] { p.Sigma = 2.0; },                         // new weights: a new domain
+      [&] { ++edit; },                                // (two objects: two graphs' flows run on)
+      [&] { p.Rings = 2; ++edit; },                   // a wider band leaves it
+      [&] { c.Element = bitten; ++edit; },
+      [&] { p.Rings = 3; },
+    };
+    int relabelled = 0;
+    for (std::size_t step = 0; step < edits.size(); ++step)
+    {
+      edits[step]();
+      for (std::size_t e = 0; e < component.size(); ++e)
+        component[e] = c.Element[e] ? 0 : -1;
+      const VoxelRefinementResult kept = RefineOnVoxels(p, NoProgress(), &cache);
+      const VoxelRefinementResult fresh = RefineOnVoxels(p);
+      ASSERT_TRUE(kept.Error.empty() && fresh.Error.empty()) << kept.Error << fresh.Error;
+      EXPECT_EQ(c.Labelled(kept), c.Labelled(fresh)) << "step " << step << (two ? ", two objects" : "");
+      EXPECT_EQ(kept.BandVoxels, fresh.BandVoxels) << "step " << step;
+      EXPECT_EQ(kept.Voxel.size(), fresh.Voxel.size()) << "step " << step;
+      EXPECT_NEAR(kept.Energy, fresh.Energy, 1e-9 * (1.0 + fresh.Energy)) << "step " << step;
+      EXPECT_EQ(kept.ComponentChange, fresh.ComponentChange) << "step " << step;
+      relabelled += fresh.Voxel.size() > 10;
+    }
+    EXPECT_EQ(relabelled, static_cast<int>(edits.size()));
   }
-  EXPECT_EQ(relabelled, static_cast<int>(edits.size()));
 }
 
 TEST(VoxelRefinement, ExpansionLowersTheBandsEnergy)

@@ -57,6 +57,33 @@ void DealComponents(std::int64_t n, const GraphEdges& edges, BinaryGraphs& g)
   }
 }
 
+// Nodes appended to a one-graph problem solved before (from `first` on, on the first graph) with
+// the edges from `firstEdge` on; each edge's ends marked for the next flow to run on.
+void ExtendGraph(BinaryGraphs& g, std::int64_t first, std::int64_t n, const GraphEdges& edges, std::int64_t firstEdge,
+  const std::vector<double>& weight)
+{
+  Flow& graph = *g.Graph[0];
+  if (n > first)
+  {
+    graph.add_node(static_cast<int>(n - first));
+  }
+  g.Side.resize(n, 0);
+  g.Local.resize(n);
+  for (std::int64_t i = first; i < n; ++i)
+  {
+    g.Local[i] = g.Nodes[0]++;
+  }
+  g.Cost.resize(2 * n, 0.0); // a new node's terminal capacities are 0
+  const std::int64_t* a = edges.First();
+  const std::int64_t* b = edges.Second();
+  for (std::int64_t e = firstEdge; e < edges.Size(); ++e)
+  {
+    graph.add_edge(g.Local[a[e]], g.Local[b[e]], weight[e], weight[e]);
+    graph.mark_node(g.Local[a[e]]);
+    graph.mark_node(g.Local[b[e]]);
+  }
+}
+
 // The max-flows of `cost` (node i's label 0 at 2 i, label 1 at 2 i + 1): on fresh graphs of the
 // edges' weights, or (reuse) on the kept graphs, their terminal capacities moved to `cost` and each
 // flow run on from the last (Kohli & Torr; the edges are unchanged). A node takes label 1 unless it
@@ -443,6 +470,44 @@ void BuildBandFaces(const Band& band, BandFaces& f)
   std::partial_sum(f.OutFirst.begin(), f.OutFirst.end(), f.OutFirst.begin());
 }
 
+// The faces of the voxels appended to a kept domain (from index `first` on), in BuildBandFaces'
+// order among them; a face to a voxel of the domain before leaves that voxel's faces outside
+// (its entry there marked -1) and becomes an edge.
+void ExtendBandFaces(const Band& band, std::int64_t first, BandFaces& f)
+{
+  const VoxelRefinementProblem& p = band.P;
+  const double inv2s2 = 1.0 / (2.0 * p.Sigma * p.Sigma);
+  for (std::int64_t i = first; i < band.Size(); ++i)
+  {
+    const std::int64_t v = band.Voxel[i];
+    std::int64_t out = 0;
+    band.Neighbours(v, [&](std::int64_t u, bool) {
+      const std::int64_t j = band.Find(u);
+      if (j >= first && j < i)
+      {
+        return; // the pair's edge comes from j
+      }
+      const double d2 = p.Distance2(v, u);
+      const double w = d2 == 0.0 ? 1.0 : std::exp(-d2 * inv2s2);
+      if (j < 0)
+      {
+        f.OutVoxel.push_back(u);
+        f.OutWeight.push_back(w);
+        ++out;
+        return;
+      }
+      for (std::int64_t k = j < first ? f.OutFirst[j] : 0; j < first && k < f.OutFirst[j + 1]; ++k)
+      {
+        f.OutVoxel[k] = f.OutVoxel[k] == v ? -1 : f.OutVoxel[k];
+      }
+      f.A.push_back(i);
+      f.B.push_back(j);
+      f.W.push_back(w);
+    });
+    f.OutFirst.push_back(f.OutFirst.back() + out);
+  }
+}
+
 // Each band voxel's cost of every label (voxel i's label l at i * Labels + l): P.Cost, a label no
 // element near its element's has priced out, then the weight of each face to a voxel outside the
 // band whose element's label differs (those labels recorded in Around). A held voxel (a binary
@@ -477,6 +542,10 @@ void BandCosts(Band& band, const BandFaces& f, const std::vector<std::uint64_t>&
       }
       for (std::int64_t k = f.OutFirst[i]; k < f.OutFirst[i + 1]; ++k)
       {
+        if (f.OutVoxel[k] < 0)
+        {
+          continue; // a face into the domain since it grew (ExtendBandFaces)
+        }
         const std::uint8_t held = band.ElementLabel(f.OutVoxel[k]);
         band.Around[i] |= held < 64 ? std::uint64_t(1) << held : 0;
         for (int l = 0; l < L; ++l)
@@ -766,11 +835,27 @@ void RefineTwoLabels(const VoxelRefinementProblem& p, const ProgressFunction& pr
     joined += bandElement[e] || (same && st.DomainElement[e]);
     inside = inside && (!bandElement[e] || st.DomainElement[e]);
   }
-  if (!inside)
+  // A band that leaves a one-graph domain joins it while the two stay within 1.5 times the band's
+  // elements: the new voxels join the graph and the flow runs on.
+  const bool extend = !inside && same && st.Binary.Nodes[1] == 0 && 2 * joined <= 3 * band;
+  const std::int64_t first = static_cast<std::int64_t>(st.Domain.size());
+  const std::int64_t firstEdge = static_cast<std::int64_t>(st.Faces.A.size());
+  st.Solved = st.Solved && (inside || extend);
+  if (extend)
+  {
+    std::vector<std::uint8_t> added(n, 0);
+    for (std::int64_t e = 0; e < n; ++e)
+    {
+      added[e] = bandElement[e] && !st.DomainElement[e];
+      st.DomainElement[e] = st.DomainElement[e] || added[e];
+    }
+    const std::vector<std::int64_t> voxels = BandVoxels(*p.Mesh, *p.Owner, added, p.Parallel);
+    st.Domain.insert(st.Domain.end(), voxels.begin(), voxels.end());
+  }
+  else if (!inside)
   {
     // A band that differs from the domain in a few elements (a seed moved back and forth) joins it,
-    // and the next such edit stays inside; one that moved further (a seed where the result was wrong)
-    // replaces it, as a larger domain would make every such edit slower.
+    // and the next such edit stays inside; one that moved further replaces it.
     std::vector<std::uint8_t> element = bandElement;
     for (std::int64_t e = 0; e < n && same && 100 * joined <= 101 * band; ++e)
     {
@@ -797,7 +882,11 @@ void RefineTwoLabels(const VoxelRefinementProblem& p, const ProgressFunction& pr
   {
     return;
   }
-  if (!inside)
+  if (extend)
+  {
+    ExtendBandFaces(domain, first, st.Faces);
+  }
+  else if (!inside)
   {
     BuildBandFaces(domain, st.Faces);
   }
@@ -812,12 +901,16 @@ void RefineTwoLabels(const VoxelRefinementProblem& p, const ProgressFunction& pr
   std::vector<std::uint8_t> x;
   try
   {
-    if (!inside)
+    if (extend)
+    {
+      ExtendGraph(st.Binary, first, domain.Size(), edges, firstEdge, st.Faces.W);
+    }
+    else if (!inside)
     {
       DealComponents(domain.Size(), edges, st.Binary);
     }
     st.Solved = false;
-    r.Energy = SolveGraphs(cost, edges, st.Faces.W, st.Binary, inside, x, p.Parallel);
+    r.Energy = SolveGraphs(cost, edges, st.Faces.W, st.Binary, inside || extend, x, p.Parallel);
     st.Solved = true;
     st.Sigma = p.Sigma;
   }

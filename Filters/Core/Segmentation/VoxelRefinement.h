@@ -70,11 +70,11 @@ struct VoxelRefinementResult
 // image's voxels to the band (4 bytes per voxel) and the expansion's memory; with two labels, the
 // domain its max-flow ran on (the band's voxels, and those of elements in an earlier band, held at
 // their elements' labels), its voxel faces and weights, and the max-flow graphs with their flow.
-// While the band stays inside the domain (a seed moved, then moved back), the next refinement moves
-// the terminal capacities and runs the flow on (Kohli & Torr) instead of building it again; its
-// labels are a fresh refinement's, as a node's label depends only on the maximum flow's residual
-// graph. A band that leaves the domain joins it while the two stay within 1.01 times the band's
-// elements, else replaces it.
+// The next refinement moves the terminal capacities and runs the flow on (Kohli & Torr) instead of
+// building it again, with the new band's voxels outside the domain added to it and its graph (one
+// graph only, while the domain holds at most 1.5 times the band's elements; else it is built again).
+// Its labels are a fresh refinement's, as a node's label depends only on the maximum flow's
+// residual graph.
 class VoxelRefinementCache
 {
 public:
