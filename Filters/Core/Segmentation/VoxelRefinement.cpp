@@ -840,7 +840,7 @@ void RefineTwoLabels(const VoxelRefinementProblem& p, const ProgressFunction& pr
   const bool extend = !inside && same && st.Binary.Nodes[1] == 0 && 2 * joined <= 3 * band;
   const std::int64_t first = static_cast<std::int64_t>(st.Domain.size());
   const std::int64_t firstEdge = static_cast<std::int64_t>(st.Faces.A.size());
-  st.Solved = st.Solved && (inside || extend);
+  st.Solved = st.Solved && inside; // until the grown or new domain is solved
   if (extend)
   {
     std::vector<std::uint8_t> added(n, 0);
