@@ -820,8 +820,9 @@ void Finish(const VoxelRefinementProblem& p, const Band& band, const GraphEdges&
   }
 }
 
-// Two labels: one exact max-flow over the kept domain (State), built afresh when the band leaves
-// it (or its weights changed), else its graphs' flow run on with the new costs.
+// Two labels: one exact max-flow over the kept domain (State). The domain grows by the band's new
+// voxels and its graph's flow runs on with the new costs; it is built afresh when it would grow past
+// 1.5 times the band's elements, when its band lay on two graphs, or when its weights changed.
 void RefineTwoLabels(const VoxelRefinementProblem& p, const ProgressFunction& progress, VoxelRefinementCache::State& st,
   const std::vector<std::uint8_t>& bandElement, VoxelRefinementResult& r)
 {
