@@ -496,9 +496,13 @@ void ExtendBandFaces(const Band& band, std::int64_t first, BandFaces& f)
         ++out;
         return;
       }
-      for (std::int64_t k = j < first ? f.OutFirst[j] : 0; j < first && k < f.OutFirst[j + 1]; ++k)
+      if (j < first)
       {
-        f.OutVoxel[k] = f.OutVoxel[k] == v ? -1 : f.OutVoxel[k];
+        // v lay outside the domain for j: their face is an edge now.
+        for (std::int64_t k = f.OutFirst[j]; k < f.OutFirst[j + 1]; ++k)
+        {
+          f.OutVoxel[k] = f.OutVoxel[k] == v ? -1 : f.OutVoxel[k];
+        }
       }
       f.A.push_back(i);
       f.B.push_back(j);
