@@ -86,7 +86,7 @@ void ExtendGraph(BinaryGraphs& g, std::int64_t first, std::int64_t n, const Grap
 
 // The max-flows of `cost` (node i's label 0 at 2 i, label 1 at 2 i + 1): on fresh graphs of the
 // edges' weights, or (reuse) on the kept graphs, their terminal capacities moved to `cost` and each
-// flow run on from the last (Kohli & Torr; the edges are unchanged). A node takes label 1 unless it
+// flow run on from the last (Kohli & Torr; edges added since, ExtendGraph). A node takes label 1 unless it
 // reaches the sink in the final residual graph, which every maximum flow leaves the same. Returns
 // the flow.
 double SolveGraphs(const std::vector<double>& cost, const GraphEdges& edges, const std::vector<double>& weight,
