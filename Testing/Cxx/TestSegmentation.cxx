@@ -1344,7 +1344,8 @@ TEST(VoxelRefinement, AKeptDomainGivesWhatAFreshRefinementGives)
     // Weights that vary along each object too (0.3-1 within, 0 across its edge).
     p.Distance2 = [&c](std::int64_t a, std::int64_t b) {
       const double d = double(c.Value[a]) - double(c.Value[b]);
-      const std::uint64_t h = (static_cast<std::uint64_t>(std::min(a, b)) * 7919u + static_cast<std::uint64_t>(std::max(a, b)) * 104729u) % 97u;
+      const std::uint64_t h =
+        (static_cast<std::uint64_t>(std::min(a, b)) * 7919u + static_cast<std::uint64_t>(std::max(a, b)) * 104729u) % 97u;
       return d * d + 0.2 * static_cast<double>(h);
     };
     p.Sigma = 3.0;

@@ -1003,7 +1003,8 @@ VoxelRefinementResult RefineOnVoxels(const VoxelRefinementProblem& p, const Prog
   {
     start[i] = band.ElementLabel(band.Voxel[i]);
   }
-  ExpansionResult x = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.4, 1.0), 1, nullptr, p.Parallel, &st.Expansion);
+  ExpansionResult x =
+    AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.4, 1.0), 1, nullptr, p.Parallel, &st.Expansion);
   if (!x.Error.empty() || x.Aborted)
   {
     r.Error = x.Error;
