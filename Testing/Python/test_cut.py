@@ -149,7 +149,8 @@ for step in range(6):
         regions, count = ndi.label(wrong)
         largest = regions == np.argmax(np.bincount(regions.ravel())[1:]) + 1
         k, j, i = np.unravel_index(int(np.argmax(ndi.distance_transform_edt(np.pad(largest, 1))[1:-1, 1:-1, 1:-1])), shape)
-        points["o" if truth[k, j, i] else "b"].append(list(vtk_image.GetPoint(vtk_image.ComputePointId([int(i), int(j), int(k)]))))
+        seed = vtk_image.GetPoint(vtk_image.ComputePointId([int(i), int(j), int(k)]))
+        points["o" if truth[k, j, i] else "b"].append(list(seed))
     else:
         points["o"][0][0] += spacing[0] * (1 if step % 4 == 1 else -1)
     po.Points, pb.Points = sum(points["o"], []), sum(points["b"], [])
