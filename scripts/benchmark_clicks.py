@@ -25,33 +25,12 @@ import statistics
 import time
 
 import numpy as np
-from scipy import ndimage as ndi
 import paraview.simple as ps
 
 import featuremesh as fm
 from featuremesh import metrics, report
 
 METHODS = ("supervoxel", "voxel", "random_walker", "watershed")
-
-
-def next_seed(result, truth, spacing):
-    """(index (k, j, i), is_object) of the robot's next seed, or None when the result is right."""
-    best = None
-    for wrong, is_object in ((result & ~truth, False), (~result & truth, True)):
-        labels, n = ndi.label(wrong)
-        if n == 0:
-            continue
-        sizes = np.bincount(labels.ravel())[1:]
-        k = int(np.argmax(sizes)) + 1
-        if best is None or sizes[k - 1] > best[0]:
-            best = (sizes[k - 1], labels == k, is_object)
-    if best is None:
-        return None
-    region = best[1]
-    # Distance to the region's border: the image's outside counts as border too.
-    padded = np.pad(region, 1)
-    distance = ndi.distance_transform_edt(padded, sampling=spacing[::-1])[1:-1, 1:-1, 1:-1]
-    return np.unravel_index(int(np.argmax(distance)), region.shape), best[2]
 
 
 class Loop:
@@ -121,7 +100,7 @@ def run(case, method, rounds, cut=None):
         lost += sum(int(mask[k, j, i] != is_object) for (i, j, k), is_object in added)
         if r == rounds:
             break
-        found = next_seed(mask, truth, spacing)
+        found = metrics.next_seed(mask, truth, spacing)
         if found is None:
             break
         (k, j, i), is_object = found

@@ -8,6 +8,7 @@ from scipy import ndimage as ndi
 from vtkmodules.vtkFiltersCore import vtkFeatureEdges
 
 import fmtest as ft
+from featuremesh.metrics import next_seed
 
 # Floors: the Dice measured at the defaults with each case's task (cases.csv; lambda 0.2, Connectivity
 # From Task, the geodesic term for Task Object) on the Delaunay mesh, minus 0.02; measured
@@ -145,12 +146,9 @@ kept = ft.SuperVoxelCut(Mesh=cut.Mesh, ObjectSeeds=po, BackgroundSeeds=pb, Image
 kept.UpdatePipeline()
 for step in range(6):
     if step % 2 == 0:
-        wrong = ft.fm.labels(kept).reshape(shape).astype(bool) != truth
-        regions, count = ndi.label(wrong)
-        largest = regions == np.argmax(np.bincount(regions.ravel())[1:]) + 1
-        k, j, i = np.unravel_index(int(np.argmax(ndi.distance_transform_edt(np.pad(largest, 1))[1:-1, 1:-1, 1:-1])), shape)
+        (k, j, i), is_object = next_seed(ft.fm.labels(kept).reshape(shape).astype(bool), truth, spacing)
         seed = vtk_image.GetPoint(vtk_image.ComputePointId([int(i), int(j), int(k)]))
-        points["o" if truth[k, j, i] else "b"].append(list(seed))
+        points["o" if is_object else "b"].append(list(seed))
     else:
         points["o"][0][0] += spacing[0] * (1 if step % 4 == 1 else -1)
     po.Points, pb.Points = sum(points["o"], []), sum(points["b"], [])

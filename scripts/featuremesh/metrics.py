@@ -338,3 +338,25 @@ def bending(surface):
     a, b = face[:-1][pair], face[1:][pair]
     cosines = np.clip(np.einsum("ij,ij->i", n[a], n[b]), -1.0, 1.0)
     return float(np.degrees(np.arccos(cosines)).mean()) if len(a) else float("nan")
+
+
+def next_seed(result, truth, spacing):
+    """(index (k, j, i), is_object) of the robot user's next seed (benchmark_clicks.py): the most interior
+    voxel of the largest error region of `result` against `truth` (boolean arrays), or None when the
+    result is right."""
+    best = None
+    for wrong, is_object in ((result & ~truth, False), (~result & truth, True)):
+        labels, n = ndi.label(wrong)
+        if n == 0:
+            continue
+        sizes = np.bincount(labels.ravel())[1:]
+        k = int(np.argmax(sizes)) + 1
+        if best is None or sizes[k - 1] > best[0]:
+            best = (sizes[k - 1], labels == k, is_object)
+    if best is None:
+        return None
+    region = best[1]
+    # Distance to the region's border: the image's outside counts as border too.
+    padded = np.pad(region, 1)
+    distance = ndi.distance_transform_edt(padded, sampling=spacing[::-1])[1:-1, 1:-1, 1:-1]
+    return np.unravel_index(int(np.argmax(distance)), region.shape), best[2]

@@ -126,8 +126,9 @@ double SolveGraphs(const std::vector<double>& cost, const GraphEdges& edges, con
     {
       for (std::int64_t i = 0; i < n; ++i)
       {
-        const double ds = cost[2 * i] - g.Cost[2 * i], dt = cost[2 * i + 1] - g.Cost[2 * i + 1];
-        if (g.Side[i] == s && (ds != 0.0 || dt != 0.0))
+        const double ds = g.Side[i] == s ? cost[2 * i] - g.Cost[2 * i] : 0.0;
+        const double dt = g.Side[i] == s ? cost[2 * i + 1] - g.Cost[2 * i + 1] : 0.0;
+        if (ds != 0.0 || dt != 0.0)
         {
           // Only a node whose terminal residual changes sign (or leaves or reaches 0) needs its
           // search tree redone.
@@ -323,36 +324,32 @@ struct Band
   std::vector<std::uint64_t> Around; // per voxel: the labels of its neighbours outside the band (bit l, l < 64)
   std::vector<std::int32_t>& Index;  // per image voxel: its band index, -1 outside the band
   // A two-label refinement's kept domain: the voxels held at their elements' labels (empty: none),
-  // and the index map left as it is for the next refinement.
+  // and whether the index map is the domain's, which writes and resets it (DropDomain).
   std::vector<std::uint8_t> Held;
-  bool KeepIndex = false;
+  bool DomainIndex = false;
   std::int64_t Stride[3];
   int Axes;
 
   Band(const VoxelRefinementProblem& p, std::vector<std::int64_t> voxels, std::vector<std::int32_t>& index,
-    bool keepIndex = false)
+    bool domainIndex = false)
     : P(p)
     , G(p.Mesh->Geometry())
     , Voxel(std::move(voxels))
     , Around(Voxel.size(), 0)
     , Index(index)
-    , KeepIndex(keepIndex)
+    , DomainIndex(domainIndex)
     , Stride{ 1, G.Dims[0], G.SliceStride() }
     , Axes(G.Is2D() ? 2 : 3)
   {
-    if (static_cast<std::int64_t>(this->Index.size()) != this->G.Size())
-    {
-      AssignFresh(this->Index, static_cast<std::size_t>(this->G.Size()), std::int32_t(-1));
-    }
-    for (std::size_t i = 0; i < this->Voxel.size(); ++i)
+    for (std::size_t i = 0; i < this->Voxel.size() && !this->DomainIndex; ++i)
     {
       this->Index[this->Voxel[i]] = static_cast<std::int32_t>(i);
     }
   }
-  // The index map is left as it was found: -1 everywhere (unless kept).
+  // The index map is left as it was found: -1 everywhere (unless it is the domain's).
   ~Band()
   {
-    for (std::size_t i = 0; i < this->Voxel.size() && !this->KeepIndex; ++i)
+    for (std::size_t i = 0; i < this->Voxel.size() && !this->DomainIndex; ++i)
     {
       this->Index[this->Voxel[i]] = -1;
     }
@@ -402,63 +399,80 @@ struct Band
 };
 
 // The band's voxel faces with their Potts weights, and per voxel its faces to voxels outside the
-// band (neighbour, weight) in compressed rows: they depend on the image alone. Fixed chunks of
-// voxels in parallel, joined in chunk order.
+// band (neighbour, weight) in compressed rows: they depend on the image alone.
 struct BandFaces
 {
   std::vector<std::int64_t> A, B, OutFirst, OutVoxel;
   std::vector<double> W, OutWeight;
 };
 
-void BuildBandFaces(const Band& band, BandFaces& f)
+// The faces of the band's voxels from index `first` on: all of them (0), or those appended to a kept
+// domain, whose faces to the voxels before become edges (those voxels' entries for them marked -1).
+// Fixed chunks of voxels in parallel, joined in chunk order.
+void BuildBandFaces(const Band& band, std::int64_t first, BandFaces& f)
 {
   const VoxelRefinementProblem& p = band.P;
   const std::int64_t nb = band.Size();
   const double inv2s2 = 1.0 / (2.0 * p.Sigma * p.Sigma);
   constexpr std::int64_t chunk = 8192;
-  const std::int64_t chunks = (nb + chunk - 1) / chunk;
+  const std::int64_t chunks = (nb - first + chunk - 1) / chunk;
   struct Part
   {
     std::vector<std::int64_t> A, B, OutVoxel;
     std::vector<double> W, OutWeight;
   };
   std::vector<Part> parts(chunks);
-  f.OutFirst.assign(nb + 1, 0);
+  if (first == 0)
+  {
+    // Emptied, their memory kept.
+    for (std::vector<std::int64_t>* list : { &f.A, &f.B, &f.OutFirst, &f.OutVoxel })
+    {
+      list->clear();
+    }
+    f.W.clear();
+    f.OutWeight.clear();
+    f.OutFirst.push_back(0);
+  }
+  f.OutFirst.resize(nb + 1, 0);
   p.Parallel(chunks, 1, [&](std::int64_t c0, std::int64_t c1) {
     for (std::int64_t c = c0; c < c1; ++c)
     {
       Part& part = parts[c];
-      const std::int64_t last = std::min(nb, (c + 1) * chunk);
-      for (std::int64_t i = c * chunk; i < last; ++i)
+      const std::int64_t last = std::min(nb, first + (c + 1) * chunk);
+      for (std::int64_t i = first + c * chunk; i < last; ++i)
       {
         const std::int64_t v = band.Voxel[i];
         band.Neighbours(v, [&](std::int64_t u, bool) {
           const std::int64_t j = band.Find(u);
-          if (j >= 0 && j < i)
+          if (j >= first && j < i)
           {
             return; // the pair's edge comes from j
           }
           const double d2 = p.Distance2(v, u);
           const double w = d2 == 0.0 ? 1.0 : std::exp(-d2 * inv2s2);
-          if (j >= 0)
+          if (j < 0)
           {
-            part.A.push_back(i);
-            part.B.push_back(j);
-            part.W.push_back(w);
+            part.OutVoxel.push_back(u);
+            part.OutWeight.push_back(w);
+            ++f.OutFirst[i + 1];
             return;
           }
-          part.OutVoxel.push_back(u);
-          part.OutWeight.push_back(w);
-          ++f.OutFirst[i + 1];
+          if (j < first)
+          {
+            // v lay outside the domain for j: their face is an edge now (each pair once, so no
+            // two threads write one entry).
+            for (std::int64_t k = f.OutFirst[j]; k < f.OutFirst[j + 1]; ++k)
+            {
+              f.OutVoxel[k] = f.OutVoxel[k] == v ? -1 : f.OutVoxel[k];
+            }
+          }
+          part.A.push_back(i);
+          part.B.push_back(j);
+          part.W.push_back(w);
         });
       }
     }
   });
-  f.A.clear();
-  f.B.clear();
-  f.W.clear();
-  f.OutVoxel.clear();
-  f.OutWeight.clear();
   for (Part& part : parts)
   {
     f.A.insert(f.A.end(), part.A.begin(), part.A.end());
@@ -467,49 +481,7 @@ void BuildBandFaces(const Band& band, BandFaces& f)
     f.OutVoxel.insert(f.OutVoxel.end(), part.OutVoxel.begin(), part.OutVoxel.end());
     f.OutWeight.insert(f.OutWeight.end(), part.OutWeight.begin(), part.OutWeight.end());
   }
-  std::partial_sum(f.OutFirst.begin(), f.OutFirst.end(), f.OutFirst.begin());
-}
-
-// The faces of the voxels appended to a kept domain (from index `first` on), in BuildBandFaces'
-// order among them; a face to a voxel of the domain before leaves that voxel's faces outside
-// (its entry there marked -1) and becomes an edge.
-void ExtendBandFaces(const Band& band, std::int64_t first, BandFaces& f)
-{
-  const VoxelRefinementProblem& p = band.P;
-  const double inv2s2 = 1.0 / (2.0 * p.Sigma * p.Sigma);
-  for (std::int64_t i = first; i < band.Size(); ++i)
-  {
-    const std::int64_t v = band.Voxel[i];
-    std::int64_t out = 0;
-    band.Neighbours(v, [&](std::int64_t u, bool) {
-      const std::int64_t j = band.Find(u);
-      if (j >= first && j < i)
-      {
-        return; // the pair's edge comes from j
-      }
-      const double d2 = p.Distance2(v, u);
-      const double w = d2 == 0.0 ? 1.0 : std::exp(-d2 * inv2s2);
-      if (j < 0)
-      {
-        f.OutVoxel.push_back(u);
-        f.OutWeight.push_back(w);
-        ++out;
-        return;
-      }
-      if (j < first)
-      {
-        // v lay outside the domain for j: their face is an edge now.
-        for (std::int64_t k = f.OutFirst[j]; k < f.OutFirst[j + 1]; ++k)
-        {
-          f.OutVoxel[k] = f.OutVoxel[k] == v ? -1 : f.OutVoxel[k];
-        }
-      }
-      f.A.push_back(i);
-      f.B.push_back(j);
-      f.W.push_back(w);
-    });
-    f.OutFirst.push_back(f.OutFirst.back() + out);
-  }
+  std::partial_sum(f.OutFirst.begin() + first, f.OutFirst.end(), f.OutFirst.begin() + first);
 }
 
 // Each band voxel's cost of every label (voxel i's label l at i * Labels + l): P.Cost, a label no
@@ -870,6 +842,11 @@ void RefineTwoLabels(const VoxelRefinementProblem& p, const ProgressFunction& pr
     st.Domain = BandVoxels(*p.Mesh, *p.Owner, element, p.Parallel);
     st.DomainElement = std::move(element);
   }
+  const std::int64_t size = static_cast<std::int64_t>(st.Domain.size());
+  for (std::int64_t i = inside ? size : extend ? first : 0; i < size; ++i)
+  {
+    st.Index[st.Domain[i]] = static_cast<std::int32_t>(i);
+  }
   Band domain(p, st.Domain, st.Index, true);
   domain.Held.resize(domain.Size());
   for (std::int64_t i = 0; i < domain.Size(); ++i)
@@ -887,13 +864,9 @@ void RefineTwoLabels(const VoxelRefinementProblem& p, const ProgressFunction& pr
   {
     return;
   }
-  if (extend)
+  if (!inside)
   {
-    ExtendBandFaces(domain, first, st.Faces);
-  }
-  else if (!inside)
-  {
-    BuildBandFaces(domain, st.Faces);
+    BuildBandFaces(domain, extend ? first : 0, st.Faces);
   }
   const GraphEdges edges(st.Faces.A, st.Faces.B);
   std::vector<double> cost;
@@ -983,7 +956,7 @@ VoxelRefinementResult RefineOnVoxels(const VoxelRefinementProblem& p, const Prog
     return r;
   }
   BandFaces faces;
-  BuildBandFaces(band, faces);
+  BuildBandFaces(band, 0, faces);
   PottsProblem pr;
   pr.Nodes = nb;
   pr.Labels = p.Labels;
