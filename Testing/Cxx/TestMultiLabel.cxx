@@ -302,15 +302,61 @@ TEST(AlphaExpansion, AWorkspaceLentAcrossProblemsChangesNothing)
         pr.Weight.push_back(0.5 + u(rng));
       for (std::int64_t i = 0; i < pr.Nodes * labels; ++i)
         pr.Cost.push_back(3.0 * u(rng));
+      // Every problem under a key of its own, each run twice: the second keeps the first's rows.
+      workspace.GraphKey = static_cast<std::uint64_t>(runs + 1);
       const ExpansionResult lent = AlphaExpansion(pr, {}, NoProgress(), 8, nullptr, SerialFor(), &workspace);
+      const ExpansionResult again = AlphaExpansion(pr, {}, NoProgress(), 8, nullptr, SerialFor(), &workspace);
       const ExpansionResult fresh = AlphaExpansion(pr, {});
       ASSERT_TRUE(lent.Error.empty() && fresh.Error.empty()) << lent.Error << fresh.Error;
       EXPECT_EQ(lent.Label, fresh.Label) << "run " << runs;
       EXPECT_EQ(lent.Energy, fresh.Energy) << "run " << runs;
+      EXPECT_EQ(again.Label, fresh.Label) << "run " << runs;
+      EXPECT_EQ(again.Energy, fresh.Energy) << "run " << runs;
       EXPECT_GT(fresh.Moves, 0);
       ++runs;
     }
   EXPECT_TRUE(workspace.Kept != nullptr);
+}
+
+TEST(AlphaExpansion, EdgesInAnyOrderGiveTheSameMoves)
+{
+  // Edges in ascending order of their first ends (a voxel band's faces) build each move from the
+  // free nodes' rows; the same edges reversed, from the whole list. The labels and energies agree.
+  std::mt19937 rng(37);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const GraphEdges grid = GraphEdges::Grid(30, 20, 1);
+  std::vector<std::int64_t> a, b;
+  grid.ForEach([&](std::int64_t, std::int64_t p, std::int64_t q) {
+    a.push_back(p);
+    b.push_back(q);
+  });
+  const GraphEdges ascending(a, b);
+  std::vector<std::int64_t> ra(a.rbegin(), a.rend()), rb(b.rbegin(), b.rend());
+  const GraphEdges reversed(ra, rb);
+  for (int labels : { 3, 4 })
+  {
+    PottsProblem pr;
+    pr.Nodes = 600;
+    pr.Labels = labels;
+    for (std::int64_t e = 0; e < grid.Size(); ++e)
+      pr.Weight.push_back(e % 7 == 0 ? 0.0 : 0.5 + u(rng)); // some zero weights, skipped either way
+    for (std::int64_t i = 0; i < pr.Nodes * labels; ++i)
+      pr.Cost.push_back(3.0 * u(rng));
+    pr.Hard.assign(pr.Nodes, -1);
+    for (int k = 0; k < 30; ++k)
+      pr.Hard[rng() % pr.Nodes] = static_cast<std::int16_t>(rng() % labels);
+    pr.Edges = &ascending;
+    const ExpansionResult rows = AlphaExpansion(pr, {});
+    PottsProblem back = pr;
+    back.Edges = &reversed;
+    back.Weight.assign(pr.Weight.rbegin(), pr.Weight.rend());
+    const ExpansionResult list = AlphaExpansion(back, {});
+    ASSERT_TRUE(rows.Error.empty() && list.Error.empty()) << rows.Error << list.Error;
+    EXPECT_GT(rows.Moves, 1);
+    EXPECT_EQ(rows.Label, list.Label) << labels << " labels";
+    EXPECT_NEAR(rows.Energy, list.Energy, 1e-9 * std::fabs(list.Energy));
+    EXPECT_EQ(rows.Moves, list.Moves);
+  }
 }
 
 TEST(AlphaExpansion, BadProblemsAreErrors)

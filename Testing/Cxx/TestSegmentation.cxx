@@ -1321,26 +1321,27 @@ TEST(VoxelRefinement, AKeptDomainGivesWhatAFreshRefinementGives)
   // (the band leaves the kept domain, which grows, or comes back inside it), the voxels' costs change
   // (the kept flow runs on), a seed's element is held, the rings shrink (voxels of the domain held),
   // sigma changes (new weights); noisy costs make pieces for the connectivity rule. One object (one
-  // graph, which grows) and two (the band's components on two graphs, built again); some after an
-  // aborted refinement. Each result labels every voxel as the fresh one does, with the same band,
-  // energy and components' changes.
-  for (const bool two : { false, true })
+  // graph, which grows) and two (the band's components on two graphs, built again), and three labels
+  // (alpha-expansion with the held voxels as hard nodes, on kept faces); some after an aborted
+  // refinement. Each result labels every voxel as the fresh one does, with the same band, energy and
+  // components' changes.
+  for (const auto& [labels, two] : { std::make_pair(2, false), std::make_pair(2, true), std::make_pair(3, true) })
   {
     RefinementCase c(two);
     for (std::uint8_t& l : c.Element)
-      l = l ? 1 : 0;
+      l = labels == 2 && l ? 1 : l;
     const std::vector<std::uint8_t> truthElement = c.Element;
     const FaceAdjacency& faces = *c.Mesh.SharedFaces();
     // Every third object element beside the background goes: a bite into the object.
     std::vector<std::uint8_t> bitten = c.Element;
     for (std::size_t k = 0; k < faces.A.size(); ++k)
       for (const auto& [a, b] : { std::make_pair(faces.A[k], faces.B[k]), std::make_pair(faces.B[k], faces.A[k]) })
-        if (truthElement[a] == 1 && truthElement[b] == 0 && a % 3 == 0)
+        if (truthElement[a] != 0 && truthElement[b] == 0 && a % 3 == 0)
           bitten[a] = 0;
     ASSERT_NE(bitten, truthElement);
     std::vector<std::int64_t> component(c.Element.size(), 0);
     int edit = 0;
-    VoxelRefinementProblem p = c.Problem(2);
+    VoxelRefinementProblem p = c.Problem(labels);
     // Weights that vary along each object too (0.3-1 within, 0 across its edge).
     p.Distance2 = [&c](std::int64_t a, std::int64_t b) {
       const double d = double(c.Value[a]) - double(c.Value[b]);
@@ -1351,13 +1352,20 @@ TEST(VoxelRefinement, AKeptDomainGivesWhatAFreshRefinementGives)
     p.Sigma = 3.0;
     p.Rings = 2;
     p.Connectivity = Connectivity::FillHoles;
-    p.Component = &component;
+    p.Component = labels == 2 ? &component : nullptr;
     p.Cost = [&](std::int64_t v, std::int64_t, double* cost) {
       // A deterministic noise per voxel and edit, against the truth on a few voxels.
       const std::uint64_t h = (static_cast<std::uint64_t>(v) * 2654435761u + static_cast<std::uint64_t>(edit) * 40503u) % 1000u;
-      const bool object = (c.Truth[v] != 0) != (h < 150);
-      cost[0] = object ? 1.5 + 0.001 * static_cast<double>(h) : 0.001 * static_cast<double>(h % 7);
-      cost[1] = !object ? 1.5 + 0.0005 * static_cast<double>(h) : 0.001 * static_cast<double>(h % 5);
+      if (labels == 2)
+      {
+        const bool object = (c.Truth[v] != 0) != (h < 150);
+        cost[0] = object ? 1.5 + 0.001 * static_cast<double>(h) : 0.001 * static_cast<double>(h % 7);
+        cost[1] = !object ? 1.5 + 0.0005 * static_cast<double>(h) : 0.001 * static_cast<double>(h % 5);
+        return;
+      }
+      const int own = h < 150 ? (c.Truth[v] + 1 + static_cast<int>(h % 2)) % 3 : c.Truth[v];
+      for (int l = 0; l < 3; ++l)
+        cost[l] = l == own ? 0.001 * static_cast<double>(h % (5 + l)) : 1.5 + 0.0005 * static_cast<double>((h + 97 * l) % 1000u);
     };
     VoxelRefinementCache cache;
     const std::vector<std::function<void()>> edits = {
@@ -1369,6 +1377,7 @@ TEST(VoxelRefinement, AKeptDomainGivesWhatAFreshRefinementGives)
       [&] { p.Fixed.assign(c.Element.size(), 0); p.Fixed[faces.A[0]] = 1; p.Fixed[faces.B[0]] = 1; },
       [&] { p.Rings = 1; c.Element = truthElement; }, // a narrower band: domain voxels held
       [&] { p.Sigma = 2.0; },                         // new weights: a new domain
+      [&] { p.Sigma = 1.0; },                         // the same domain built again, new weights
       [&] { ++edit; },                                // (two objects: two graphs' flows run on)
       [&] { p.Rings = 2; ++edit; },                   // a wider band leaves it
       [&] { c.Element = bitten; ++edit; },
@@ -1388,7 +1397,7 @@ TEST(VoxelRefinement, AKeptDomainGivesWhatAFreshRefinementGives)
       const VoxelRefinementResult kept = RefineOnVoxels(p, NoProgress(), &cache);
       const VoxelRefinementResult fresh = RefineOnVoxels(p);
       ASSERT_TRUE(kept.Error.empty() && fresh.Error.empty()) << kept.Error << fresh.Error;
-      EXPECT_EQ(c.Labelled(kept), c.Labelled(fresh)) << "step " << step << (two ? ", two objects" : "");
+      EXPECT_EQ(c.Labelled(kept), c.Labelled(fresh)) << "step " << step << ", " << labels << " labels" << (two ? ", two objects" : "");
       EXPECT_EQ(kept.BandVoxels, fresh.BandVoxels) << "step " << step;
       EXPECT_EQ(kept.Voxel.size(), fresh.Voxel.size()) << "step " << step;
       EXPECT_NEAR(kept.Energy, fresh.Energy, 1e-9 * (1.0 + fresh.Energy)) << "step " << step;

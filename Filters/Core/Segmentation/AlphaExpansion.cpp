@@ -198,6 +198,9 @@ struct Neighbourhood
 {
   std::vector<double> Reach, Weight;
   std::vector<std::int64_t> First, Neighbour, Side;
+  // Whether the edges come in ascending order of their first ends (a voxel band's faces): then a
+  // node's first-end entries, in the order of the nodes, are the edges in their own order.
+  bool FirstEndsAscending = false;
   Neighbourhood() = default;
   explicit Neighbourhood(const PottsProblem& pr) { this->Build(pr); }
   // Reuses the vectors' memory.
@@ -206,11 +209,15 @@ struct Neighbourhood
     const std::int64_t n = pr.Nodes;
     this->Reach.assign(n, 0.0);
     this->First.assign(n + 1, 0);
+    this->FirstEndsAscending = true;
+    std::int64_t last = 0;
     pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
       this->Reach[p] += pr.Weight[k];
       this->Reach[q] += pr.Weight[k];
       ++this->First[p + 1];
       ++this->First[q + 1];
+      this->FirstEndsAscending = this->FirstEndsAscending && p >= last;
+      last = p;
     });
     for (std::int64_t p = 0; p < n; ++p)
     {
@@ -297,6 +304,44 @@ double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::u
   }
   g.reset();
   g.add_node(active);
+  if (around.FirstEndsAscending)
+  {
+    // The same terms and edges from the free nodes' rows alone: each node's sums in its edges'
+    // order, the edges added in theirs (a move of few free nodes skips most edges).
+    for (std::int64_t p = 0; p < n; ++p)
+    {
+      if (id[p] < 0)
+      {
+        continue;
+      }
+      const int a = label[p];
+      for (std::int64_t j = around.First[p]; j < around.First[p + 1]; ++j)
+      {
+        const double w = around.Weight[j];
+        const std::int64_t q = around.Neighbour[j];
+        if (w == 0.0)
+        {
+          continue;
+        }
+        const int b = label[q];
+        if (id[q] < 0)
+        {
+          keep[p] += a != b ? w : 0.0;
+          take[p] += alpha != b ? w : 0.0;
+        }
+        else if ((around.Side[j] & 1) == 0)
+        {
+          g.add_edge(id[p], id[q], w, a == b ? w : 0.0);
+        }
+        else if (a != b)
+        {
+          keep[p] += w;
+        }
+      }
+    }
+  }
+  else
+  {
   pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
     const double w = pr.Weight[k];
     const int a = label[p], b = label[q];
@@ -324,6 +369,7 @@ double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::u
       g.add_edge(id[p], id[q], w, 0.0);
     }
   });
+  }
   for (std::int64_t p = 0; p < n; ++p)
   {
     if (id[p] >= 0)
@@ -380,6 +426,7 @@ struct RecycledMoves::State
 struct ExpansionWorkspace::State
 {
   Neighbourhood Around;
+  std::uint64_t AroundKey = 0; // the GraphKey Around was built for
   std::unique_ptr<Flow> Graph;
   MoveBuffers Buffers;
 };
@@ -750,7 +797,14 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
         w.Kept = std::make_unique<ExpansionWorkspace::State>();
       }
       fresh = w.Kept.get();
-      fresh->Around.Build(pr);
+      const std::vector<std::int64_t>& rows = fresh->Around.First;
+      if (w.GraphKey == 0 || fresh->AroundKey != w.GraphKey || static_cast<std::int64_t>(rows.size()) != n + 1 ||
+        rows.back() != 2 * m)
+      {
+        fresh->AroundKey = 0; // until built
+        fresh->Around.Build(pr);
+      }
+      fresh->AroundKey = w.GraphKey;
       if (!fresh->Graph)
       {
         fresh->Graph = std::make_unique<Flow>(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory);

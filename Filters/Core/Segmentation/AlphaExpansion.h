@@ -66,6 +66,10 @@ public:
   ~ExpansionWorkspace();
   ExpansionWorkspace(ExpansionWorkspace&&) noexcept;
   ExpansionWorkspace& operator=(ExpansionWorkspace&&) noexcept;
+  // A caller that keeps one graph with its weights across expansions names them by a key (0: none):
+  // while the key stays, the nodes' rows of edges are kept instead of built again. New edges or
+  // weights need a new key.
+  std::uint64_t GraphKey = 0;
   struct State;
   std::unique_ptr<State> Kept;
 };

@@ -315,44 +315,29 @@ std::vector<std::int64_t> BandVoxels(const SimplexMesh& mesh, const VoxelOwnerMa
   return voxels;
 }
 
-// The band's voxels and what lies around them.
+// The kept domain's voxels and what lies around them: the band's voxels, and those held at their
+// elements' labels (Held).
 struct Band
 {
   const VoxelRefinementProblem& P;
   const ImageGeometry& G;
-  std::vector<std::int64_t> Voxel;
-  std::vector<std::uint64_t> Around; // per voxel: the labels of its neighbours outside the band (bit l, l < 64)
-  std::vector<std::int32_t>& Index;  // per image voxel: its band index, -1 outside the band
-  // A two-label refinement's kept domain: the voxels held at their elements' labels (empty: none),
-  // and whether the index map is the domain's, which writes and resets it (DropDomain).
+  const std::vector<std::int64_t>& Voxel;
+  std::vector<std::uint64_t> Around; // per voxel: the labels of its neighbours outside the domain (bit l, l < 64)
+  const std::vector<std::int32_t>& Index; // per image voxel: its domain index, -1 outside the domain
   std::vector<std::uint8_t> Held;
-  bool DomainIndex = false;
   std::int64_t Stride[3];
   int Axes;
 
-  Band(const VoxelRefinementProblem& p, std::vector<std::int64_t> voxels, std::vector<std::int32_t>& index,
-    bool domainIndex = false)
+  Band(const VoxelRefinementProblem& p, const std::vector<std::int64_t>& voxels, const std::vector<std::int32_t>& index)
     : P(p)
     , G(p.Mesh->Geometry())
-    , Voxel(std::move(voxels))
+    , Voxel(voxels)
     , Around(Voxel.size(), 0)
     , Index(index)
-    , DomainIndex(domainIndex)
+    , Held(Voxel.size(), 0)
     , Stride{ 1, G.Dims[0], G.SliceStride() }
     , Axes(G.Is2D() ? 2 : 3)
   {
-    for (std::size_t i = 0; i < this->Voxel.size() && !this->DomainIndex; ++i)
-    {
-      this->Index[this->Voxel[i]] = static_cast<std::int32_t>(i);
-    }
-  }
-  // The index map is left as it was found: -1 everywhere (unless it is the domain's).
-  ~Band()
-  {
-    for (std::size_t i = 0; i < this->Voxel.size() && !this->DomainIndex; ++i)
-    {
-      this->Index[this->Voxel[i]] = -1;
-    }
   }
   Band(const Band&) = delete;
   Band& operator=(const Band&) = delete;
@@ -364,7 +349,7 @@ struct Band
   }
   // The band index of voxel u, -1 outside the band.
   std::int64_t Find(std::int64_t u) const { return this->Index[u]; }
-  bool IsHeld(std::int64_t i) const { return !this->Held.empty() && this->Held[i]; }
+  bool IsHeld(std::int64_t i) const { return this->Held[i] != 0; }
   // Whether voxel u is refined (in the band, not held).
   bool Free(std::int64_t u) const
   {
@@ -484,11 +469,11 @@ void BuildBandFaces(const Band& band, std::int64_t first, BandFaces& f)
   std::partial_sum(f.OutFirst.begin() + first, f.OutFirst.end(), f.OutFirst.begin() + first);
 }
 
-// Each band voxel's cost of every label (voxel i's label l at i * Labels + l): P.Cost, a label no
+// Each domain voxel's cost of every label (voxel i's label l at i * Labels + l): P.Cost, a label no
 // element near its element's has priced out, then the weight of each face to a voxel outside the
-// band whose element's label differs (those labels recorded in Around). A held voxel (a binary
-// refinement's kept domain) pays 0 for its element's label and more than all its faces' weights
-// (each at most 1) for the other. Fixed chunks of voxels in parallel.
+// domain whose element's label differs (those labels recorded in Around). A held voxel pays 0 for
+// its element's label and more than all its faces' weights (each at most 1) for any other (the
+// expansion also makes it a hard node). Fixed chunks of voxels in parallel.
 void BandCosts(Band& band, const BandFaces& f, const std::vector<std::uint64_t>& near, std::vector<double>& cost)
 {
   const VoxelRefinementProblem& p = band.P;
@@ -507,8 +492,10 @@ void BandCosts(Band& band, const BandFaces& f, const std::vector<std::uint64_t>&
       if (band.IsHeld(i))
       {
         const std::uint8_t held = band.ElementLabel(v);
-        c[held] = 0.0;
-        c[1 - held] = hold;
+        for (int l = 0; l < L; ++l)
+        {
+          c[l] = l == held ? 0.0 : hold;
+        }
         continue;
       }
       p.Cost(v, e, c);
@@ -737,13 +724,16 @@ std::vector<double> ComponentChanges(const VoxelRefinementProblem& p, const Voxe
 struct VoxelRefinementCache::State
 {
   std::vector<std::int32_t> Index; // per image voxel: its index in the kept domain, else -1
-  // Two labels: the kept domain (its voxels and elements), its faces, its max-flow graphs holding the
-  // last flow, and the sigma of its weights.
+  // The kept domain (its voxels and elements), its faces, the sigma of their weights and the label
+  // count it was solved for; two labels: its max-flow graphs holding the last flow; more: the
+  // expansion's memory, which keeps its rows of edges while the faces stay (FacesVersion).
   std::vector<std::int64_t> Domain;
   std::vector<std::uint8_t> DomainElement;
   BandFaces Faces;
+  std::uint64_t FacesVersion = 0;
   BinaryGraphs Binary;
   double Sigma = 0.0;
+  int Labels = 0;
   bool Solved = false;
   ExpansionWorkspace Expansion;
 };
@@ -796,14 +786,20 @@ void Finish(const VoxelRefinementProblem& p, const Band& band, const GraphEdges&
   }
 }
 
-// Two labels: one exact max-flow over the kept domain (State). The domain grows by the band's new
-// voxels and its graph's flow runs on with the new costs; it is built afresh when it would grow past
-// 1.5 times the band's elements, when its band lay on two graphs, or when its weights changed.
-void RefineTwoLabels(const VoxelRefinementProblem& p, const ProgressFunction& progress, VoxelRefinementCache::State& st,
-  const std::vector<std::uint8_t>& bandElement, VoxelRefinementResult& r)
+// The refinement over the kept domain (State): the band's voxels, and those of elements in an earlier
+// band held at their elements' labels. The domain grows by the band's new voxels; it is built afresh
+// when it would grow past 1.5 times the band's elements, when its two-label band lay on two graphs, or
+// when its weights or the label count changed. Two labels: one exact max-flow, the last one's run on
+// with the new costs. More: one cycle of alpha-expansion from the elements' labels (a second moved no
+// case's Dice by more than 0.001 and took as long again, docs/multilabel.md), held voxels as hard
+// nodes, on the kept faces.
+void RefineOnDomain(const VoxelRefinementProblem& p, const ProgressFunction& progress, VoxelRefinementCache::State& st,
+  const std::vector<std::uint8_t>& bandElement, const std::vector<std::uint64_t>& near, VoxelRefinementResult& r)
 {
+  const bool binary = p.Labels == 2;
   const std::int64_t n = static_cast<std::int64_t>(bandElement.size());
-  const bool same = st.Solved && st.Sigma == p.Sigma && static_cast<std::int64_t>(st.DomainElement.size()) == n;
+  const bool same =
+    st.Solved && st.Sigma == p.Sigma && st.Labels == p.Labels && static_cast<std::int64_t>(st.DomainElement.size()) == n;
   bool inside = same;
   std::int64_t band = 0, joined = 0;
   for (std::int64_t e = 0; e < n; ++e)
@@ -814,7 +810,7 @@ void RefineTwoLabels(const VoxelRefinementProblem& p, const ProgressFunction& pr
   }
   // A band that leaves a one-graph domain joins it while the two stay within 1.5 times the band's
   // elements: the new voxels join the graph and the flow runs on.
-  const bool extend = !inside && same && st.Binary.Nodes[1] == 0 && 2 * joined <= 3 * band;
+  const bool extend = !inside && same && (!binary || st.Binary.Nodes[1] == 0) && 2 * joined <= 3 * band;
   const std::int64_t first = static_cast<std::int64_t>(st.Domain.size());
   const std::int64_t firstEdge = static_cast<std::int64_t>(st.Faces.A.size());
   st.Solved = st.Solved && inside; // until the grown or new domain is solved
@@ -847,8 +843,7 @@ void RefineTwoLabels(const VoxelRefinementProblem& p, const ProgressFunction& pr
   {
     st.Index[st.Domain[i]] = static_cast<std::int32_t>(i);
   }
-  Band domain(p, st.Domain, st.Index, true);
-  domain.Held.resize(domain.Size());
+  Band domain(p, st.Domain, st.Index);
   for (std::int64_t i = 0; i < domain.Size(); ++i)
   {
     domain.Held[i] = !bandElement[(*p.Owner)[domain.Voxel[i]]];
@@ -867,37 +862,72 @@ void RefineTwoLabels(const VoxelRefinementProblem& p, const ProgressFunction& pr
   if (!inside)
   {
     BuildBandFaces(domain, extend ? first : 0, st.Faces);
+    ++st.FacesVersion;
   }
   const GraphEdges edges(st.Faces.A, st.Faces.B);
   std::vector<double> cost;
-  BandCosts(domain, st.Faces, {}, cost);
+  BandCosts(domain, st.Faces, near, cost);
   if (!progress(0.4))
   {
     r.Aborted = true;
     return;
   }
   std::vector<std::uint8_t> x;
-  try
+  if (binary)
   {
-    if (extend)
+    try
     {
-      ExtendGraph(st.Binary, first, domain.Size(), edges, firstEdge, st.Faces.W);
+      if (extend)
+      {
+        ExtendGraph(st.Binary, first, domain.Size(), edges, firstEdge, st.Faces.W);
+      }
+      else if (!inside)
+      {
+        DealComponents(domain.Size(), edges, st.Binary);
+      }
+      st.Solved = false;
+      r.Energy = SolveGraphs(cost, edges, st.Faces.W, st.Binary, inside || extend, x, p.Parallel);
+      st.Solved = true;
+      st.Sigma = p.Sigma;
+      st.Labels = p.Labels;
     }
-    else if (!inside)
+    catch (const std::exception&)
     {
-      DealComponents(domain.Size(), edges, st.Binary);
+      r.Error = "not enough memory for the voxel refinement's max-flow (" + std::to_string(domain.Size()) + " voxels).";
+      return;
     }
-    st.Solved = false;
-    r.Energy = SolveGraphs(cost, edges, st.Faces.W, st.Binary, inside || extend, x, p.Parallel);
+  }
+  else
+  {
+    PottsProblem pr;
+    pr.Nodes = domain.Size();
+    pr.Labels = p.Labels;
+    pr.Cost = std::move(cost);
+    pr.Edges = &edges;
+    pr.Hard.assign(pr.Nodes, -1);
+    std::vector<std::uint8_t> start(pr.Nodes);
+    for (std::int64_t i = 0; i < pr.Nodes; ++i)
+    {
+      start[i] = domain.ElementLabel(domain.Voxel[i]);
+      pr.Hard[i] = domain.Held[i] ? start[i] : std::int16_t(-1);
+    }
+    pr.Weight.swap(st.Faces.W); // lent for the expansion
+    st.Expansion.GraphKey = st.FacesVersion;
+    ExpansionResult e = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.4, 1.0), 1, nullptr, p.Parallel, &st.Expansion);
+    pr.Weight.swap(st.Faces.W);
+    if (!e.Error.empty() || e.Aborted)
+    {
+      r.Error = e.Error;
+      r.Aborted = e.Aborted;
+      return;
+    }
     st.Solved = true;
     st.Sigma = p.Sigma;
+    st.Labels = p.Labels;
+    r.Energy = e.Energy;
+    x = std::move(e.Label);
   }
-  catch (const std::exception&)
-  {
-    r.Error = "not enough memory for the voxel refinement's max-flow (" + std::to_string(domain.Size()) + " voxels).";
-    return;
-  }
-  // The flow holds the faces between held voxels of two labels, which the band's energy does not.
+  // The domain's energy holds the faces between held voxels of two labels, which the band's does not.
   for (std::size_t e = 0; e < st.Faces.A.size() && held; ++e)
   {
     const std::int64_t i = st.Faces.A[e], j = st.Faces.B[e];
@@ -936,56 +966,7 @@ VoxelRefinementResult RefineOnVoxels(const VoxelRefinementProblem& p, const Prog
   std::vector<std::uint8_t> bandElement;
   std::vector<std::uint64_t> near;
   BandElements(p, *p.Mesh->SharedFaces(), bandElement, near);
-  if (p.Labels == 2)
-  {
-    RefineTwoLabels(p, progress, st, bandElement, r);
-    r.Seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    return r;
-  }
-  DropDomain(st);
-  Band band(p, BandVoxels(*p.Mesh, *p.Owner, bandElement, p.Parallel), st.Index);
-  const std::int64_t nb = r.BandVoxels = band.Size();
-  if (!progress(0.2))
-  {
-    r.Aborted = true;
-    return r;
-  }
-  if (nb == 0)
-  {
-    r.Seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    return r;
-  }
-  BandFaces faces;
-  BuildBandFaces(band, 0, faces);
-  PottsProblem pr;
-  pr.Nodes = nb;
-  pr.Labels = p.Labels;
-  BandCosts(band, faces, near, pr.Cost);
-  pr.Weight = std::move(faces.W);
-  const GraphEdges edges = GraphEdges::Owned(std::move(faces.A), std::move(faces.B));
-  pr.Edges = &edges;
-  if (!progress(0.4))
-  {
-    r.Aborted = true;
-    return r;
-  }
-  // Alpha-expansion from the elements' labels. One cycle over the labels: from the elements' labels a
-  // second moved no case's Dice by more than 0.001 and took as long again (docs/multilabel.md).
-  std::vector<std::uint8_t> start(nb);
-  for (std::int64_t i = 0; i < nb; ++i)
-  {
-    start[i] = band.ElementLabel(band.Voxel[i]);
-  }
-  ExpansionResult x =
-    AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.4, 1.0), 1, nullptr, p.Parallel, &st.Expansion);
-  if (!x.Error.empty() || x.Aborted)
-  {
-    r.Error = x.Error;
-    r.Aborted = x.Aborted;
-    return r;
-  }
-  r.Energy = x.Energy;
-  Finish(p, band, edges, x.Label, bandElement, r);
+  RefineOnDomain(p, progress, st, bandElement, near, r);
   r.Seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return r;
 }

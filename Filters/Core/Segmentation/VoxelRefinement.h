@@ -67,14 +67,14 @@ struct VoxelRefinementResult
 };
 
 // What a refinement keeps for the next (a seed edit's re-cut) of one mesh and image: a map of the
-// image's voxels to the band (4 bytes per voxel) and the expansion's memory; with two labels, the
-// domain its max-flow ran on (the band's voxels, and those of elements in an earlier band, held at
-// their elements' labels), its voxel faces and weights, and the max-flow graphs with their flow.
-// The next refinement moves the terminal capacities and runs the flow on (Kohli & Torr) instead of
-// building it again, with the new band's voxels outside the domain added to it and its graph (one
-// graph only, while the domain holds at most 1.5 times the band's elements; else it is built again).
-// Its labels are a fresh refinement's, as a node's label depends only on the maximum flow's
-// residual graph.
+// image's voxels to the domain (4 bytes per voxel), the domain (the band's voxels, and those of
+// elements in an earlier band, held at their elements' labels) with its voxel faces and weights, and
+// the solver's state. The next refinement adds the new band's voxels outside the domain to it while
+// the domain holds at most 1.5 times the band's elements, else builds it again. Two labels: the
+// max-flow graphs with their flow, whose terminal capacities move and whose flow runs on (Kohli &
+// Torr; one graph only); its labels are a fresh refinement's, as a node's label depends only on the
+// maximum flow's residual graph. More labels: the expansion's memory and, while the faces stay, its
+// rows of edges; each move's optimum is a fresh band's (held voxels are hard nodes).
 class VoxelRefinementCache
 {
 public:
