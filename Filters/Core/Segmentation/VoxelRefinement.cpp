@@ -324,7 +324,7 @@ struct Band
   const std::vector<std::int64_t>& Voxel;
   std::vector<std::uint64_t> Around; // per voxel: the labels of its neighbours outside the domain (bit l, l < 64)
   const std::vector<std::int32_t>& Index; // per image voxel: its domain index, -1 outside the domain
-  std::vector<std::uint8_t> Held;
+  std::vector<std::uint8_t> Held, Own;    // per voxel: held, and its element's label (SetHeld)
   std::int64_t Stride[3];
   int Axes;
 
@@ -335,9 +335,31 @@ struct Band
     , Around(Voxel.size(), 0)
     , Index(index)
     , Held(Voxel.size(), 0)
+    , Own(Voxel.size(), 0)
     , Stride{ 1, G.Dims[0], G.SliceStride() }
     , Axes(G.Is2D() ? 2 : 3)
   {
+  }
+  // Each voxel's element label, and whether its element lies outside the band (it is held); the
+  // band's voxel count. Fixed chunks of voxels in parallel.
+  std::int64_t SetHeld(const std::vector<std::uint8_t>& bandElement)
+  {
+    constexpr std::int64_t chunk = 16384;
+    const std::int64_t n = this->Size(), chunks = (n + chunk - 1) / chunk;
+    std::vector<std::int64_t> free(chunks, 0);
+    this->P.Parallel(chunks, 1, [&](std::int64_t c0, std::int64_t c1) {
+      for (std::int64_t c = c0; c < c1; ++c)
+      {
+        for (std::int64_t i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i)
+        {
+          const std::int32_t e = (*this->P.Owner)[this->Voxel[i]];
+          this->Own[i] = e >= 0 ? (*this->P.Label)[e] : std::uint8_t(0);
+          this->Held[i] = e < 0 || !bandElement[e];
+          free[c] += !this->Held[i];
+        }
+      }
+    });
+    return std::accumulate(free.begin(), free.end(), std::int64_t(0));
   }
   Band(const Band&) = delete;
   Band& operator=(const Band&) = delete;
@@ -491,7 +513,7 @@ void BandCosts(Band& band, const BandFaces& f, const std::vector<std::uint64_t>&
       band.Around[i] = 0;
       if (band.IsHeld(i))
       {
-        const std::uint8_t held = band.ElementLabel(v);
+        const std::uint8_t held = band.Own[i];
         for (int l = 0; l < L; ++l)
         {
           c[l] = l == held ? 0.0 : hold;
@@ -618,7 +640,7 @@ void LoneVoxelsAround(const Band& band, const std::vector<std::uint8_t>& x, std:
   std::vector<std::int64_t> halo;
   for (std::int64_t i = 0; i < band.Size(); ++i)
   {
-    const std::uint8_t before = band.ElementLabel(band.Voxel[i]);
+    const std::uint8_t before = band.Own[i];
     if (x[i] != before)
     {
       band.Neighbours(band.Voxel[i], [&](std::int64_t u, bool) {
@@ -771,7 +793,7 @@ void Finish(const VoxelRefinementProblem& p, const Band& band, const GraphEdges&
   LoneVoxelsAround(band, x, loneVoxel, loneLabel);
   for (std::int64_t i = 0; i < band.Size(); ++i)
   {
-    if (x[i] != band.ElementLabel(band.Voxel[i]))
+    if (x[i] != band.Own[i])
     {
       r.Voxel.push_back(band.Voxel[i]);
       r.Label.push_back(x[i]);
@@ -844,11 +866,7 @@ void RefineOnDomain(const VoxelRefinementProblem& p, const ProgressFunction& pro
     st.Index[st.Domain[i]] = static_cast<std::int32_t>(i);
   }
   Band domain(p, st.Domain, st.Index);
-  for (std::int64_t i = 0; i < domain.Size(); ++i)
-  {
-    domain.Held[i] = !bandElement[(*p.Owner)[domain.Voxel[i]]];
-    r.BandVoxels += !domain.Held[i];
-  }
+  r.BandVoxels = domain.SetHeld(bandElement);
   const bool held = r.BandVoxels < domain.Size();
   if (!progress(0.2))
   {
@@ -908,7 +926,7 @@ void RefineOnDomain(const VoxelRefinementProblem& p, const ProgressFunction& pro
     std::vector<std::uint8_t> start(pr.Nodes);
     for (std::int64_t i = 0; i < pr.Nodes; ++i)
     {
-      start[i] = domain.ElementLabel(domain.Voxel[i]);
+      start[i] = domain.Own[i];
       pr.Hard[i] = domain.Held[i] ? start[i] : std::int16_t(-1);
     }
     pr.Weight.swap(st.Faces.W); // lent for the expansion
