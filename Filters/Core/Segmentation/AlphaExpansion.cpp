@@ -191,6 +191,18 @@ double EnergyBound(const PottsProblem& pr, const ParallelFor& parallel)
   return K;
 }
 
+// v sized n; grown, its capacity half again as large: a graph that grows a little from one call to
+// the next (a voxel band's kept domain) keeps its arrays and their pages, not fresh ones each time.
+template <typename T>
+void ResizeWithRoom(std::vector<T>& v, std::size_t n)
+{
+  if (v.capacity() < n)
+  {
+    v.reserve(n + n / 2);
+  }
+  v.resize(n);
+}
+
 // Each node's summed boundary weight (Reach: the most a move's pairwise terms can reward it for
 // switching), and its neighbours with the edges' weights in compressed rows (First), to price a
 // move by the nodes it moved. Side: 2 e when the node is edge e's first end, 2 e + 1 its second.
@@ -207,8 +219,10 @@ struct Neighbourhood
   void Build(const PottsProblem& pr)
   {
     const std::int64_t n = pr.Nodes;
-    this->Reach.assign(n, 0.0);
-    this->First.assign(n + 1, 0);
+    ResizeWithRoom(this->Reach, n);
+    ResizeWithRoom(this->First, n + 1);
+    std::fill(this->Reach.begin(), this->Reach.end(), 0.0);
+    std::fill(this->First.begin(), this->First.end(), 0);
     this->FirstEndsAscending = true;
     std::int64_t last = 0;
     pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
@@ -223,9 +237,9 @@ struct Neighbourhood
     {
       this->First[p + 1] += this->First[p];
     }
-    this->Neighbour.resize(this->First[n]);
-    this->Weight.resize(this->First[n]);
-    this->Side.resize(this->First[n]);
+    ResizeWithRoom(this->Neighbour, this->First[n]);
+    ResizeWithRoom(this->Weight, this->First[n]);
+    ResizeWithRoom(this->Side, this->First[n]);
     std::vector<std::int64_t> at(this->First.begin(), this->First.end() - 1);
     pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
       this->Side[at[p]] = 2 * k;
@@ -281,9 +295,9 @@ double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::u
   std::vector<double>& keep = buffers.Keep;
   std::vector<double>& take = buffers.Take;
   std::vector<std::int32_t>& id = buffers.Id;
-  keep.resize(n);
-  take.resize(n);
-  id.resize(n);
+  ResizeWithRoom(keep, n);
+  ResizeWithRoom(take, n);
+  ResizeWithRoom(id, n);
   std::int32_t active = 0;
   for (std::int64_t p = 0; p < n; ++p)
   {
