@@ -1394,6 +1394,9 @@ TEST(VoxelRefinement, AKeptDomainGivesWhatAFreshRefinementGives)
       const double stop = step % 2 ? 0.15 : 0.3;
       if (step % 3 == 1)
         EXPECT_TRUE(RefineOnVoxels(p, [stop](double f) { return f < stop; }, &cache).Aborted);
+      // With three labels, also an abort within the expansion (its moves report progress).
+      if (labels == 3 && step % 5 == 4)
+        EXPECT_TRUE(RefineOnVoxels(p, [](double f) { return f < 0.7; }, &cache).Aborted);
       const VoxelRefinementResult kept = RefineOnVoxels(p, NoProgress(), &cache);
       const VoxelRefinementResult fresh = RefineOnVoxels(p);
       ASSERT_TRUE(kept.Error.empty() && fresh.Error.empty()) << kept.Error << fresh.Error;

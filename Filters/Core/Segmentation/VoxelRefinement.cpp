@@ -369,7 +369,7 @@ struct Band
     const std::int32_t e = (*this->P.Owner)[v];
     return e >= 0 ? (*this->P.Label)[e] : std::uint8_t(0);
   }
-  // The band index of voxel u, -1 outside the band.
+  // The domain index of voxel u, -1 outside the domain.
   std::int64_t Find(std::int64_t u) const { return this->Index[u]; }
   bool IsHeld(std::int64_t i) const { return this->Held[i] != 0; }
   // Whether voxel u is refined (in the band, not held).
@@ -830,8 +830,8 @@ void RefineOnDomain(const VoxelRefinementProblem& p, const ProgressFunction& pro
     joined += bandElement[e] || (same && st.DomainElement[e]);
     inside = inside && (!bandElement[e] || st.DomainElement[e]);
   }
-  // A band that leaves a one-graph domain joins it while the two stay within 1.5 times the band's
-  // elements: the new voxels join the graph and the flow runs on.
+  // A band that leaves the domain (with two labels, a one-graph domain) joins it while the two stay
+  // within 1.5 times the band's elements: the new voxels join the graph (and the flow runs on).
   const bool extend = !inside && same && (!binary || st.Binary.Nodes[1] == 0) && 2 * joined <= 3 * band;
   const std::int64_t first = static_cast<std::int64_t>(st.Domain.size());
   const std::int64_t firstEdge = static_cast<std::int64_t>(st.Faces.A.size());
@@ -929,10 +929,20 @@ void RefineOnDomain(const VoxelRefinementProblem& p, const ProgressFunction& pro
       start[i] = domain.Own[i];
       pr.Hard[i] = domain.Held[i] ? start[i] : std::int16_t(-1);
     }
-    pr.Weight.swap(st.Faces.W); // lent for the expansion
     st.Expansion.GraphKey = st.FacesVersion;
-    ExpansionResult e = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.4, 1.0), 1, nullptr, p.Parallel, &st.Expansion);
-    pr.Weight.swap(st.Faces.W);
+    ExpansionResult e;
+    {
+      // The weights are lent to the expansion and given back, whatever it throws.
+      struct GiveBack
+      {
+        std::vector<double>& Lent;
+        std::vector<double>& Owner;
+        ~GiveBack() { this->Lent.swap(this->Owner); }
+      };
+      pr.Weight.swap(st.Faces.W);
+      const GiveBack back{ pr.Weight, st.Faces.W };
+      e = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.4, 1.0), 1, nullptr, p.Parallel, &st.Expansion);
+    }
     if (!e.Error.empty() || e.Aborted)
     {
       r.Error = e.Error;
