@@ -285,6 +285,41 @@ TEST(FeatureNodes, LatticesAreEvenInWorldUnitsOnThickSlices)
         EXPECT_EQ(iso.Positions[n][0] - lastX, p.UniformSpacing);
       lastX = iso.Positions[n][0];
     }
+  // One axis thinner than the other two (0.7 x 0.7 x 0.35 mm, as a volume resampled to as many
+  // voxels on each axis): the uniform lattice keeps the step in voxels of the other two axes, and its
+  // step across the thin one is as long in mm. Steps in voxels of the finest axis halved the other
+  // two axes' steps (about four times the nodes). (A box deep enough on every axis for uniform nodes
+  // beyond the boundary nodes' window.)
+  g.Dims = { { 60, 50, 60 } };
+  const std::vector<float> deep(g.Size(), 10.f);
+  auto uniformGaps = [&](const std::array<double, 3>& spacing, std::int64_t& count) {
+    g.Spacing = spacing;
+    const auto r2 = ComputeFeatureNodes(deep.data(), nullptr, g, p, SerialFor(), NoProgress());
+    count = r2.Counts[int(NodeType::Uniform)];
+    std::array<int, 3> gap{ { 1 << 30, 1 << 30, 1 << 30 } };
+    for (std::size_t m = 0; m < r2.Positions.size(); ++m)
+      for (std::size_t n = 0; n < r2.Positions.size(); ++n)
+      {
+        if (r2.Type[m] != NodeType::Uniform || r2.Type[n] != NodeType::Uniform)
+          continue;
+        const auto &x = r2.Positions[m], &y = r2.Positions[n];
+        for (int a = 0; a < 3; ++a)
+          if (y[a] > x[a] && y[(a + 1) % 3] == x[(a + 1) % 3] && y[(a + 2) % 3] == x[(a + 2) % 3])
+            gap[a] = std::min(gap[a], y[a] - x[a]);
+      }
+    return gap;
+  };
+  std::int64_t isoCount = 0, thinCount = 0;
+  const std::array<int, 3> isoGap = uniformGaps({ { 0.7, 0.7, 0.7 } }, isoCount);
+  const std::array<int, 3> thinGap = uniformGaps({ { 0.7, 0.7, 0.35 } }, thinCount);
+  ASSERT_GT(isoCount, 0);
+  ASSERT_GT(thinCount, 0);
+  for (int a = 0; a < 3; ++a)
+    EXPECT_EQ(isoGap[a], p.UniformSpacing) << "axis " << a;
+  EXPECT_EQ(thinGap[0], p.UniformSpacing);
+  EXPECT_EQ(thinGap[1], p.UniformSpacing);
+  EXPECT_EQ(thinGap[2], 2 * p.UniformSpacing);
+  EXPECT_LE(thinCount, isoCount);
 }
 
 TEST(FeatureNodes, VolumeNodesDoNotDependOnHowLoopsAreSplit)

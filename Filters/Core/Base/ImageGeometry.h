@@ -43,6 +43,18 @@ struct ImageGeometry
     const double inPlane = std::min(std::fabs(Spacing[0]), std::fabs(Spacing[1]));
     return Is2D() ? inPlane : std::min(inPlane, std::fabs(Spacing[2]));
   }
+  // The median |spacing| of the three axes (2D: the finer of the two): the finest when two axes
+  // share it (thick slices), else one axis thinner than the other two does not set it.
+  double MedianSpacing() const
+  {
+    std::array<double, 3> s{ { std::fabs(Spacing[0]), std::fabs(Spacing[1]), std::fabs(Spacing[2]) } };
+    if (Is2D())
+    {
+      return std::min(s[0], s[1]);
+    }
+    std::sort(s.begin(), s.end());
+    return s[1];
+  }
   std::int64_t SliceStride() const { return static_cast<std::int64_t>(Dims[0]) * Dims[1]; }
   // The (i, j, k) of a voxel index: the inverse of Index.
   std::array<int, 3> Coordinates(std::int64_t v) const

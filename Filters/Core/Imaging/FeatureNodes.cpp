@@ -25,18 +25,19 @@ double SecondsSince(Clock::time_point t0)
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// `voxels` voxels of the image's finest axis, per axis in that axis's voxels (at least `least`):
-// the lattices' steps and windows are even in world units on an anisotropic grid. Steps in voxels
-// leave the box's edges dense across thin slices and sparse across thick ones (slivers stage 3
-// cannot mend) and stage 3 fills the thick slices' gaps with nodes (docs/smoothing.md). An
-// isotropic grid keeps `voxels` on every axis.
+// `voxels` voxels of the image's median axis (thick slices: of the in-plane axes), per axis in
+// that axis's voxels (at least `least`): the lattices' steps and windows are even in world units on
+// an anisotropic grid. Steps in voxels leave the box's edges dense across thin slices and sparse
+// across thick ones (slivers stage 3 cannot mend) and stage 3 fills the thick slices' gaps with
+// nodes; steps of the finest axis densified the other two axes' lattices when one axis was thinner
+// than both (docs/smoothing.md). An isotropic grid keeps `voxels` on every axis.
 std::array<int, 3> EvenSteps(const ImageGeometry& g, int voxels, int least)
 {
-  const double finest = g.FinestSpacing();
+  const double unit = g.MedianSpacing();
   std::array<int, 3> step{ { voxels, voxels, voxels } };
   for (int a = 0; a < g.Dimension(); ++a)
   {
-    step[a] = std::max(least, static_cast<int>(std::lround(voxels * finest / std::fabs(g.Spacing[a]))));
+    step[a] = std::max(least, static_cast<int>(std::lround(voxels * unit / std::fabs(g.Spacing[a]))));
   }
   return step;
 }
