@@ -89,7 +89,7 @@ void ExtendGraph(BinaryGraphs& g, std::int64_t first, std::int64_t n, const Grap
 // flow run on from the last (Kohli & Torr; edges added since, ExtendGraph). A node takes label 1 unless it
 // reaches the sink in the final residual graph, which every maximum flow leaves the same. Returns
 // the flow.
-double SolveGraphs(const std::vector<double>& cost, const GraphEdges& edges, const std::vector<double>& weight,
+double SolveGraphs(std::vector<double> cost, const GraphEdges& edges, const std::vector<double>& weight,
   BinaryGraphs& g, bool reuse, std::vector<std::uint8_t>& label, const ParallelFor& parallel)
 {
   const std::int64_t n = static_cast<std::int64_t>(g.Side.size());
@@ -180,7 +180,7 @@ double SolveGraphs(const std::vector<double>& cost, const GraphEdges& edges, con
       }
     }
   }
-  g.Cost = cost;
+  g.Cost = std::move(cost); // kept for the next flow's terminal changes
   return energy[0] + energy[1];
 }
 
@@ -323,17 +323,20 @@ struct Band
   const ImageGeometry& G;
   const std::vector<std::int64_t>& Voxel;
   std::vector<std::uint64_t> Around; // per voxel: the labels of its neighbours outside the domain (bit l, l < 64)
-  const std::vector<std::int32_t>& Index; // per image voxel: its domain index, -1 outside the domain
+  const std::vector<std::int32_t>& Index; // the domain's index map (State::Index), from voxel IndexFirst on
+  std::int64_t IndexFirst;
   std::vector<std::uint8_t> Held, Own;    // per voxel: held, and its element's label (SetHeld)
   std::int64_t Stride[3];
   int Axes;
 
-  Band(const VoxelRefinementProblem& p, const std::vector<std::int64_t>& voxels, const std::vector<std::int32_t>& index)
+  Band(const VoxelRefinementProblem& p, const std::vector<std::int64_t>& voxels, const std::vector<std::int32_t>& index,
+    std::int64_t indexFirst)
     : P(p)
     , G(p.Mesh->Geometry())
     , Voxel(voxels)
     , Around(Voxel.size(), 0)
     , Index(index)
+    , IndexFirst(indexFirst)
     , Held(Voxel.size(), 0)
     , Own(Voxel.size(), 0)
     , Stride{ 1, G.Dims[0], G.SliceStride() }
@@ -370,12 +373,16 @@ struct Band
     return e >= 0 ? (*this->P.Label)[e] : std::uint8_t(0);
   }
   // The domain index of voxel u, -1 outside the domain.
-  std::int64_t Find(std::int64_t u) const { return this->Index[u]; }
+  std::int64_t Find(std::int64_t u) const
+  {
+    const std::uint64_t k = static_cast<std::uint64_t>(u - this->IndexFirst);
+    return k < this->Index.size() ? this->Index[k] : -1;
+  }
   bool IsHeld(std::int64_t i) const { return this->Held[i] != 0; }
   // Whether voxel u is refined (in the band, not held).
   bool Free(std::int64_t u) const
   {
-    const std::int64_t j = this->Index[u];
+    const std::int64_t j = this->Find(u);
     return j >= 0 && !this->IsHeld(j);
   }
   // f(u, forward) for every face neighbour u of voxel v; `border` is set when v lies on the image's border.
@@ -555,8 +562,8 @@ void VoxelConnectivity(const Band& band, const GraphEdges& edges, std::vector<st
     return;
   }
   const std::int64_t nb = band.Size();
-  std::vector<std::int64_t> root(nb);
-  std::iota(root.begin(), root.end(), std::int64_t(0));
+  std::vector<std::int32_t> root(nb); // the domain's indices are 32-bit (State::Index)
+  std::iota(root.begin(), root.end(), std::int32_t(0));
   const auto find = [&](std::int64_t c) {
     while (root[c] != c)
     {
@@ -568,7 +575,7 @@ void VoxelConnectivity(const Band& band, const GraphEdges& edges, std::vector<st
     if (x[a] == x[b])
     {
       const std::int64_t ra = find(a), rb = find(b);
-      root[std::max(ra, rb)] = std::min(ra, rb);
+      root[std::max(ra, rb)] = static_cast<std::int32_t>(std::min(ra, rb));
     }
   });
   std::vector<std::uint8_t> anchored(nb, 0);
@@ -584,7 +591,7 @@ void VoxelConnectivity(const Band& band, const GraphEdges& edges, std::vector<st
   }
   // Faces each loose piece shares with each other label.
   std::vector<std::array<std::int64_t, 64>> shared;
-  std::vector<std::int64_t> slot(nb, -1);
+  std::vector<std::int32_t> slot(nb, -1);
   for (std::int64_t i = 0; i < nb; ++i)
   {
     const std::int64_t r = find(i);
@@ -594,7 +601,7 @@ void VoxelConnectivity(const Band& band, const GraphEdges& edges, std::vector<st
     }
     if (slot[r] < 0)
     {
-      slot[r] = static_cast<std::int64_t>(shared.size());
+      slot[r] = static_cast<std::int32_t>(shared.size());
       shared.emplace_back();
       shared.back().fill(0);
     }
@@ -745,7 +752,10 @@ std::vector<double> ComponentChanges(const VoxelRefinementProblem& p, const Voxe
 
 struct VoxelRefinementCache::State
 {
-  std::vector<std::int32_t> Index; // per image voxel: its index in the kept domain, else -1
+  // Per voxel of the slices (2D: rows) the domain spans, from voxel IndexFirst on: its index in the
+  // kept domain, else -1 (a 512^3 volume's band spans a part of its slices). The image's voxel count.
+  std::vector<std::int32_t> Index;
+  std::int64_t IndexFirst = 0, Voxels = -1;
   // The kept domain (its voxels and elements), its faces, the sigma of their weights and the label
   // count it was solved for; two labels: its max-flow graphs holding the last flow; more: the
   // expansion's memory, which keeps its rows of edges while the faces stay (FacesVersion).
@@ -775,7 +785,7 @@ void DropDomain(VoxelRefinementCache::State& st)
 {
   for (std::int64_t v : st.Domain)
   {
-    st.Index[v] = -1;
+    st.Index[v - st.IndexFirst] = -1;
   }
   st.Domain.clear();
   st.DomainElement.clear();
@@ -805,6 +815,37 @@ void Finish(const VoxelRefinementProblem& p, const Band& band, const GraphEdges&
   if (p.Component && p.Labels == 2 && p.Component->size() == p.Label->size() && !p.Component->empty())
   {
     r.ComponentChange = ComponentChanges(p, r, bandElement);
+  }
+}
+
+// The index map of the domain's voxels from `from` on. The map covers the slices (2D: rows) from the
+// domain's lowest to its highest voxel; a domain beyond it gets a map of both spans, every voxel
+// written again.
+void IndexDomain(VoxelRefinementCache::State& st, const ImageGeometry& g, std::int64_t from)
+{
+  const std::int64_t n = static_cast<std::int64_t>(st.Domain.size());
+  if (from >= n)
+  {
+    return;
+  }
+  const std::int64_t slice = g.Is2D() ? g.Dims[0] : g.SliceStride();
+  const auto [low, high] = std::minmax_element(st.Domain.begin() + from, st.Domain.end());
+  std::int64_t first = *low / slice * slice, last = (*high / slice + 1) * slice;
+  const std::int64_t mapped = st.IndexFirst + static_cast<std::int64_t>(st.Index.size());
+  if (first < st.IndexFirst || last > mapped)
+  {
+    if (from > 0)
+    {
+      first = std::min(first, st.IndexFirst);
+      last = std::max(last, mapped);
+    }
+    AssignFresh(st.Index, static_cast<std::size_t>(last - first), std::int32_t(-1));
+    st.IndexFirst = first;
+    from = 0;
+  }
+  for (std::int64_t i = from; i < n; ++i)
+  {
+    st.Index[st.Domain[i] - st.IndexFirst] = static_cast<std::int32_t>(i);
   }
 }
 
@@ -860,12 +901,8 @@ void RefineOnDomain(const VoxelRefinementProblem& p, const ProgressFunction& pro
     st.Domain = BandVoxels(*p.Mesh, *p.Owner, element, p.Parallel);
     st.DomainElement = std::move(element);
   }
-  const std::int64_t size = static_cast<std::int64_t>(st.Domain.size());
-  for (std::int64_t i = inside ? size : extend ? first : 0; i < size; ++i)
-  {
-    st.Index[st.Domain[i]] = static_cast<std::int32_t>(i);
-  }
-  Band domain(p, st.Domain, st.Index);
+  IndexDomain(st, p.Mesh->Geometry(), inside ? static_cast<std::int64_t>(st.Domain.size()) : extend ? first : 0);
+  Band domain(p, st.Domain, st.Index, st.IndexFirst);
   r.BandVoxels = domain.SetHeld(bandElement);
   const bool held = r.BandVoxels < domain.Size();
   if (!progress(0.2))
@@ -904,7 +941,7 @@ void RefineOnDomain(const VoxelRefinementProblem& p, const ProgressFunction& pro
         DealComponents(domain.Size(), edges, st.Binary);
       }
       st.Solved = false;
-      r.Energy = SolveGraphs(cost, edges, st.Faces.W, st.Binary, inside || extend, x, p.Parallel);
+      r.Energy = SolveGraphs(std::move(cost), edges, st.Faces.W, st.Binary, inside || extend, x, p.Parallel);
       st.Solved = true;
       st.Sigma = p.Sigma;
       st.Labels = p.Labels;
@@ -985,11 +1022,13 @@ VoxelRefinementResult RefineOnVoxels(const VoxelRefinementProblem& p, const Prog
     return r;
   }
   VoxelRefinementCache::State& st = *kept.Kept;
-  if (static_cast<std::int64_t>(st.Index.size()) != p.Mesh->Geometry().Size())
+  if (st.Voxels != p.Mesh->Geometry().Size())
   {
     st.Domain.clear();
     st.Solved = false;
-    AssignFresh(st.Index, static_cast<std::size_t>(p.Mesh->Geometry().Size()), std::int32_t(-1));
+    std::vector<std::int32_t>().swap(st.Index);
+    st.IndexFirst = 0;
+    st.Voxels = p.Mesh->Geometry().Size();
   }
   std::vector<std::uint8_t> bandElement;
   std::vector<std::uint64_t> near;
