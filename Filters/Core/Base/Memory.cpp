@@ -5,6 +5,9 @@
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 namespace featuremesh
 {
@@ -22,6 +25,13 @@ void AdviseHugePages(const void* data, std::size_t bytes)
 #else
   (void)data;
   (void)bytes;
+#endif
+}
+
+void ReturnFreedMemory()
+{
+#if defined(__GLIBC__)
+  malloc_trim(0);
 #endif
 }
 } // namespace featuremesh

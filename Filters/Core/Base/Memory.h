@@ -12,6 +12,12 @@ namespace featuremesh
 // Asks for huge pages over the whole 2 MB blocks of [data, data + bytes); not yet touched memory only.
 void AdviseHugePages(const void* data, std::size_t bytes);
 
+// Hands the pages of freed heap blocks back to the system (glibc's malloc_trim; elsewhere nothing).
+// Blocks under malloc's mmap threshold (at most 32 MB) stay resident when freed, and the next large
+// buffer (a label image) comes on top of them: after a large image's temporaries, this lowers the
+// process's peak.
+void ReturnFreedMemory();
+
 // `v` holding n copies of `value` in fresh memory advised for huge pages (its old contents dropped).
 template <typename T>
 void AssignFresh(std::vector<T>& v, std::size_t n, const T& value = T())
