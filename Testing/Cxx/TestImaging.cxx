@@ -223,6 +223,26 @@ TEST(FeatureNodes, CornersAreNodesAndOneNodePerVoxel)
   EXPECT_GT(r.Counts[int(NodeType::Canny)], 0);
 }
 
+namespace
+{
+// The smallest gap in voxels between two uniform nodes on one line along each axis (2^30: none).
+std::array<int, 3> UniformGaps(const FeatureNodeResult& r)
+{
+  std::array<int, 3> gap{ { 1 << 30, 1 << 30, 1 << 30 } };
+  for (std::size_t m = 0; m < r.Positions.size(); ++m)
+    for (std::size_t n = 0; n < r.Positions.size(); ++n)
+    {
+      if (r.Type[m] != NodeType::Uniform || r.Type[n] != NodeType::Uniform)
+        continue;
+      const auto &x = r.Positions[m], &y = r.Positions[n];
+      for (int a = 0; a < 3; ++a)
+        if (y[a] > x[a] && y[(a + 1) % 3] == x[(a + 1) % 3] && y[(a + 2) % 3] == x[(a + 2) % 3])
+          gap[a] = std::min(gap[a], y[a] - x[a]);
+    }
+  return gap;
+}
+} // namespace
+
 TEST(FeatureNodes, LatticesAreEvenInWorldUnitsOnThickSlices)
 {
   // A constant volume (boundary and uniform nodes only) of 3 x 3 x 12 mm voxels, as a thick-slice
@@ -258,21 +278,11 @@ TEST(FeatureNodes, LatticesAreEvenInWorldUnitsOnThickSlices)
     EXPECT_LT(edgeGap(a), 1.4 * mean) << "axis " << a;
   }
   // The uniform lattice: the smallest gap between two uniform nodes on one line along each axis.
-  std::array<double, 3> step{ { 1e300, 1e300, 1e300 } };
-  for (std::size_t m = 0; m < r.Positions.size(); ++m)
-    for (std::size_t n = 0; n < r.Positions.size(); ++n)
-    {
-      if (r.Type[m] != NodeType::Uniform || r.Type[n] != NodeType::Uniform)
-        continue;
-      const auto &x = r.Positions[m], &y = r.Positions[n];
-      for (int a = 0; a < 3; ++a)
-        if (y[a] > x[a] && y[(a + 1) % 3] == x[(a + 1) % 3] && y[(a + 2) % 3] == x[(a + 2) % 3])
-          step[a] = std::min(step[a], (y[a] - x[a]) * g.Spacing[a]);
-    }
+  const std::array<int, 3> gaps = UniformGaps(r);
   for (int a = 0; a < 3; ++a)
   {
-    EXPECT_GT(step[a], 0.6 * mean) << "axis " << a;
-    EXPECT_LT(step[a], 1.4 * mean) << "axis " << a;
+    EXPECT_GT(gaps[a] * g.Spacing[a], 0.6 * mean) << "axis " << a;
+    EXPECT_LT(gaps[a] * g.Spacing[a], 1.4 * mean) << "axis " << a;
   }
   // Isotropic voxels of any size keep the step in voxels.
   g.Spacing = { { 0.7, 0.7, 0.7 } };
@@ -296,18 +306,7 @@ TEST(FeatureNodes, LatticesAreEvenInWorldUnitsOnThickSlices)
     g.Spacing = spacing;
     const auto r2 = ComputeFeatureNodes(deep.data(), nullptr, g, p, SerialFor(), NoProgress());
     count = r2.Counts[int(NodeType::Uniform)];
-    std::array<int, 3> gap{ { 1 << 30, 1 << 30, 1 << 30 } };
-    for (std::size_t m = 0; m < r2.Positions.size(); ++m)
-      for (std::size_t n = 0; n < r2.Positions.size(); ++n)
-      {
-        if (r2.Type[m] != NodeType::Uniform || r2.Type[n] != NodeType::Uniform)
-          continue;
-        const auto &x = r2.Positions[m], &y = r2.Positions[n];
-        for (int a = 0; a < 3; ++a)
-          if (y[a] > x[a] && y[(a + 1) % 3] == x[(a + 1) % 3] && y[(a + 2) % 3] == x[(a + 2) % 3])
-            gap[a] = std::min(gap[a], y[a] - x[a]);
-      }
-    return gap;
+    return UniformGaps(r2);
   };
   std::int64_t isoCount = 0, thinCount = 0;
   const std::array<int, 3> isoGap = uniformGaps({ { 0.7, 0.7, 0.7 } }, isoCount);
