@@ -325,7 +325,7 @@ struct Band
   std::vector<std::uint64_t> Around; // per voxel: the labels of its neighbours outside the domain (bit l, l < 64)
   const std::vector<std::int32_t>& Index; // the domain's index map (State::Index), from voxel IndexFirst on
   std::int64_t IndexFirst;
-  std::vector<std::uint8_t> Held, Own;    // per voxel: held, and its element's label (SetHeld)
+  std::vector<std::uint8_t> Held, Own;    // per voxel: held, and its element's label (ReadElements)
   std::int64_t Stride[3];
   int Axes;
 
@@ -345,7 +345,7 @@ struct Band
   }
   // Each voxel's element label, and whether its element lies outside the band (it is held); the
   // band's voxel count. Fixed chunks of voxels in parallel.
-  std::int64_t SetHeld(const std::vector<std::uint8_t>& bandElement)
+  std::int64_t ReadElements(const std::vector<std::uint8_t>& bandElement)
   {
     constexpr std::int64_t chunk = 16384;
     const std::int64_t n = this->Size(), chunks = (n + chunk - 1) / chunk;
@@ -849,6 +849,70 @@ void IndexDomain(VoxelRefinementCache::State& st, const ImageGeometry& g, std::i
   }
 }
 
+// Two labels: the domain's max-flow, on the kept graphs (`inside`), on the kept graph grown by the
+// voxels from `first` and the edges from `firstEdge` on (`extend`), else on new graphs. False with
+// r.Error when memory runs out.
+bool SolveTwoLabels(const Band& domain, const GraphEdges& edges, bool inside, bool extend, std::int64_t first,
+  std::int64_t firstEdge, std::vector<double> cost, VoxelRefinementCache::State& st, std::vector<std::uint8_t>& x,
+  VoxelRefinementResult& r)
+{
+  try
+  {
+    if (extend)
+    {
+      ExtendGraph(st.Binary, first, domain.Size(), edges, firstEdge, st.Faces.W);
+    }
+    else if (!inside)
+    {
+      DealComponents(domain.Size(), edges, st.Binary);
+    }
+    r.Energy = SolveGraphs(std::move(cost), edges, st.Faces.W, st.Binary, inside || extend, x, domain.P.Parallel);
+    return true;
+  }
+  catch (const std::exception&)
+  {
+    r.Error = "not enough memory for the voxel refinement's max-flow (" + std::to_string(domain.Size()) + " voxels).";
+    return false;
+  }
+}
+
+// More labels: one cycle of alpha-expansion from the elements' labels, held voxels as hard nodes, on
+// the domain's faces (their rows of edges kept while FacesVersion stays). False with r.Error or
+// r.Aborted.
+bool ExpandOnDomain(const Band& domain, const GraphEdges& edges, std::vector<double> cost, const ProgressFunction& progress,
+  VoxelRefinementCache::State& st, std::vector<std::uint8_t>& x, VoxelRefinementResult& r)
+{
+  PottsProblem pr;
+  pr.Nodes = domain.Size();
+  pr.Labels = domain.P.Labels;
+  pr.Cost = std::move(cost);
+  pr.Edges = &edges;
+  pr.Hard.resize(pr.Nodes);
+  for (std::int64_t i = 0; i < pr.Nodes; ++i)
+  {
+    pr.Hard[i] = domain.Held[i] ? domain.Own[i] : std::int16_t(-1);
+  }
+  st.Expansion.GraphKey = st.FacesVersion;
+  ExpansionResult e;
+  {
+    // The weights are lent to the expansion and given back, whatever it throws.
+    struct GiveBack
+    {
+      std::vector<double>& Lent;
+      std::vector<double>& Owner;
+      ~GiveBack() { this->Lent.swap(this->Owner); }
+    };
+    pr.Weight.swap(st.Faces.W);
+    const GiveBack back{ pr.Weight, st.Faces.W };
+    e = AlphaExpansion(pr, domain.Own, SubProgress(progress, 0.4, 1.0), 1, nullptr, domain.P.Parallel, &st.Expansion);
+  }
+  r.Error = e.Error;
+  r.Aborted = e.Aborted;
+  r.Energy = e.Energy;
+  x = std::move(e.Label);
+  return r.Error.empty() && !r.Aborted;
+}
+
 // The refinement over the kept domain (State): the band's voxels, and those of elements in an earlier
 // band held at their elements' labels. The domain grows by the band's new voxels; it is built afresh
 // when it would grow past 1.5 times the band's elements, when its two-label band lay on two graphs, or
@@ -903,7 +967,7 @@ void RefineOnDomain(const VoxelRefinementProblem& p, const ProgressFunction& pro
   }
   IndexDomain(st, p.Mesh->Geometry(), inside ? static_cast<std::int64_t>(st.Domain.size()) : extend ? first : 0);
   Band domain(p, st.Domain, st.Index, st.IndexFirst);
-  r.BandVoxels = domain.SetHeld(bandElement);
+  r.BandVoxels = domain.ReadElements(bandElement);
   const bool held = r.BandVoxels < domain.Size();
   if (!progress(0.2))
   {
@@ -930,68 +994,19 @@ void RefineOnDomain(const VoxelRefinementProblem& p, const ProgressFunction& pro
   std::vector<std::uint8_t> x;
   if (binary)
   {
-    try
+    st.Solved = false; // until the flow has run
+    if (!SolveTwoLabels(domain, edges, inside, extend, first, firstEdge, std::move(cost), st, x, r))
     {
-      if (extend)
-      {
-        ExtendGraph(st.Binary, first, domain.Size(), edges, firstEdge, st.Faces.W);
-      }
-      else if (!inside)
-      {
-        DealComponents(domain.Size(), edges, st.Binary);
-      }
-      st.Solved = false;
-      r.Energy = SolveGraphs(std::move(cost), edges, st.Faces.W, st.Binary, inside || extend, x, p.Parallel);
-      st.Solved = true;
-      st.Sigma = p.Sigma;
-      st.Labels = p.Labels;
-    }
-    catch (const std::exception&)
-    {
-      r.Error = "not enough memory for the voxel refinement's max-flow (" + std::to_string(domain.Size()) + " voxels).";
       return;
     }
   }
-  else
+  else if (!ExpandOnDomain(domain, edges, std::move(cost), progress, st, x, r))
   {
-    PottsProblem pr;
-    pr.Nodes = domain.Size();
-    pr.Labels = p.Labels;
-    pr.Cost = std::move(cost);
-    pr.Edges = &edges;
-    pr.Hard.assign(pr.Nodes, -1);
-    std::vector<std::uint8_t> start(pr.Nodes);
-    for (std::int64_t i = 0; i < pr.Nodes; ++i)
-    {
-      start[i] = domain.Own[i];
-      pr.Hard[i] = domain.Held[i] ? start[i] : std::int16_t(-1);
-    }
-    st.Expansion.GraphKey = st.FacesVersion;
-    ExpansionResult e;
-    {
-      // The weights are lent to the expansion and given back, whatever it throws.
-      struct GiveBack
-      {
-        std::vector<double>& Lent;
-        std::vector<double>& Owner;
-        ~GiveBack() { this->Lent.swap(this->Owner); }
-      };
-      pr.Weight.swap(st.Faces.W);
-      const GiveBack back{ pr.Weight, st.Faces.W };
-      e = AlphaExpansion(pr, std::move(start), SubProgress(progress, 0.4, 1.0), 1, nullptr, p.Parallel, &st.Expansion);
-    }
-    if (!e.Error.empty() || e.Aborted)
-    {
-      r.Error = e.Error;
-      r.Aborted = e.Aborted;
-      return;
-    }
-    st.Solved = true;
-    st.Sigma = p.Sigma;
-    st.Labels = p.Labels;
-    r.Energy = e.Energy;
-    x = std::move(e.Label);
+    return;
   }
+  st.Solved = true;
+  st.Sigma = p.Sigma;
+  st.Labels = p.Labels;
   // The domain's energy holds the faces between held voxels of two labels, which the band's does not.
   for (std::size_t e = 0; e < st.Faces.A.size() && held; ++e)
   {
