@@ -5,6 +5,7 @@
 #include "SimplexMesh.h"
 #include "Vector3.h"
 #include "Parallel.h"
+#include "Percentile.h"
 #include "TestHelpers.h"
 
 #include <gtest/gtest.h>
@@ -237,6 +238,35 @@ TEST(Statistics, MeanAndCountAreExact)
   }
   EXPECT_EQ(total, 20);
   EXPECT_NEAR(sum, 190.0, 1e-9);
+}
+
+// The histogram range's two percentiles from one partially sorted sample equal each rank's value
+// in a full sort, with ties and a second channel; every 2nd tuple is sampled past 1 M tuples.
+TEST(Statistics, StridedRangeIsTheSortedSamplesRanks)
+{
+  std::mt19937 rng(7);
+  for (const std::int64_t n : { std::int64_t(1), std::int64_t(2), std::int64_t(1000), std::int64_t(96845), std::int64_t(2000001) })
+  {
+    std::vector<float> values(2 * n);
+    for (float& v : values)
+    {
+      v = rng() % 5 == 0 ? 0.f : static_cast<float>(rng() % 256);
+    }
+    for (int c = 0; c < 2; ++c)
+    {
+      std::vector<double> sample;
+      for (std::int64_t i = 0; i < n; i += std::max<std::int64_t>(1, n / 1000000))
+      {
+        sample.push_back(values[2 * i + c]);
+      }
+      std::sort(sample.begin(), sample.end());
+      const auto at = [&](double q) { return sample[static_cast<std::size_t>(q / 100.0 * (sample.size() - 1) + 0.5)]; };
+      const std::array<double, 2> range = StridedRange(values.data(), n, 2, c);
+      EXPECT_EQ(range[0], at(0.5)) << n << " tuples, channel " << c;
+      EXPECT_EQ(range[1], at(99.5)) << n << " tuples, channel " << c;
+    }
+  }
+  EXPECT_EQ(StridedRange(static_cast<const float*>(nullptr), 0)[1], 0.0);
 }
 
 // A rotated, offset, anisotropic frame: world -> index -> world round trips, voxel centres snap

@@ -2,20 +2,21 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <vector>
 
 namespace featuremesh
 {
-// Percentile q (0..100) of component c of n tuples of `channels` interleaved values, over at most
-// ~1 M evenly strided tuples (a 9 M-voxel volume is not copied and partially sorted whole); 0 when
-// n is 0.
+// A histogram's range over component c of n tuples of `channels` interleaved values: their 0.5 and
+// 99.5 percentiles, from one sample of at most ~1 M evenly strided tuples (a 9 M-voxel volume is
+// not copied and partially sorted whole); { 0, 0 } when n is 0.
 template <typename T>
-double StridedPercentile(const T* values, std::int64_t n, double q, int channels = 1, int c = 0)
+std::array<double, 2> StridedRange(const T* values, std::int64_t n, int channels = 1, int c = 0)
 {
   if (n <= 0)
   {
-    return 0.0;
+    return { { 0.0, 0.0 } };
   }
   const std::int64_t stride = std::max<std::int64_t>(1, n / 1000000);
   std::vector<double> v;
@@ -24,8 +25,17 @@ double StridedPercentile(const T* values, std::int64_t n, double q, int channels
   {
     v.push_back(static_cast<double>(values[i * channels + c]));
   }
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q / 100.0 * static_cast<double>(v.size() - 1) + 0.5));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
+  const auto rank = [&](double q) {
+    return std::min(v.size() - 1, static_cast<std::size_t>(q / 100.0 * static_cast<double>(v.size() - 1) + 0.5));
+  };
+  const auto low = v.begin() + static_cast<std::ptrdiff_t>(rank(0.5));
+  const auto high = v.begin() + static_cast<std::ptrdiff_t>(rank(99.5));
+  std::nth_element(v.begin(), low, v.end());
+  // Every value after the low rank is at least its value: the high rank's is among them.
+  if (high > low)
+  {
+    std::nth_element(low + 1, high, v.end());
+  }
+  return { { *low, *high } };
 }
 } // namespace featuremesh

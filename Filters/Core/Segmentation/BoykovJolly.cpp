@@ -388,8 +388,9 @@ bool GroupVoxelValues(const std::int32_t* owner, const T* values, std::int64_t v
   grouped.ValueType = VoxelTypeIndex<T>();
   grouped.Voxels = voxels;
   grouped.Nodes = nodes;
-  grouped.Low = StridedPercentile(values, voxels, 0.5);
-  grouped.High = StridedPercentile(values, voxels, 99.5);
+  const std::array<double, 2> range = StridedRange(values, voxels);
+  grouped.Low = range[0];
+  grouped.High = range[1];
   grouped.Keep = std::move(keep);
   return progress(1.0);
 }
@@ -737,8 +738,10 @@ HistogramLattice MakeHistogramLattice(const CutProblem& pr, const BoykovJollyPar
 {
   const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
   const NodeVoxelValues* exact = pr.NodeVoxels;
-  const double low = exact ? exact->Low : StridedPercentile(pr.Value.data(), n, 0.5);
-  double high = exact ? exact->High : StridedPercentile(pr.Value.data(), n, 99.5);
+  const std::array<double, 2> range =
+    exact ? std::array<double, 2>{ { exact->Low, exact->High } } : StridedRange(pr.Value.data(), n);
+  const double low = range[0];
+  double high = range[1];
   high = high > low ? high : low + 1.0;
   const int base = par.Bins > 0
     ? par.Bins

@@ -24,9 +24,8 @@ constexpr int MixtureComponents = 4;
 template <typename T>
 std::array<double, 2> ChannelRange(const T* values, int channels, int c, std::int64_t voxels)
 {
-  const double low = StridedPercentile(values, voxels, 0.5, channels, c);
-  const double high = StridedPercentile(values, voxels, 99.5, channels, c);
-  return { { low, high > low ? high : low + 1.0 } };
+  const std::array<double, 2> range = StridedRange(values, voxels, channels, c);
+  return { { range[0], range[1] > range[0] ? range[1] : range[0] + 1.0 } };
 }
 
 // A Gaussian blur of `grid` (PerChannel^channels bins) along `axis`, sigma `h` bins, truncated at 3h.
