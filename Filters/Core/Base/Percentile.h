@@ -8,9 +8,9 @@
 
 namespace featuremesh
 {
-// A histogram's range over component c of n tuples of `channels` interleaved values: their 0.5 and
-// 99.5 percentiles, from one sample of at most ~1 M evenly strided tuples (a 9 M-voxel volume is
-// not copied and partially sorted whole); { 0, 0 } when n is 0.
+// The 0.5 and 99.5 percentiles of component c of n tuples of `channels` interleaved values, from one
+// sample of at most ~1 M evenly strided tuples (a 9 M-voxel volume is not copied and partially
+// sorted whole); { 0, 0 } when n is 0.
 template <typename T>
 std::array<double, 2> StridedRange(const T* values, std::int64_t n, int channels = 1, int c = 0)
 {
@@ -37,5 +37,13 @@ std::array<double, 2> StridedRange(const T* values, std::int64_t n, int channels
     std::nth_element(low + 1, high, v.end());
   }
   return { { *low, *high } };
+}
+
+// A histogram's range over the values: their StridedRange, one unit wide when its ends meet.
+template <typename T>
+std::array<double, 2> HistogramRange(const T* values, std::int64_t n, int channels = 1, int c = 0)
+{
+  const std::array<double, 2> range = StridedRange(values, n, channels, c);
+  return { { range[0], range[1] > range[0] ? range[1] : range[0] + 1.0 } };
 }
 } // namespace featuremesh

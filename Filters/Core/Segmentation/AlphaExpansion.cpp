@@ -356,33 +356,33 @@ double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::u
   }
   else
   {
-  pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
-    const double w = pr.Weight[k];
-    const int a = label[p], b = label[q];
-    if (w == 0.0 || (id[p] < 0 && id[q] < 0))
-    {
-      return;
-    }
-    if (id[p] < 0 || id[q] < 0)
-    {
-      // One end fixed at its label f: the other pays w when its choice differs from f.
-      const std::int64_t x = id[p] < 0 ? q : p;
-      const int f = id[p] < 0 ? a : b;
-      const int own = id[p] < 0 ? b : a;
-      keep[x] += own != f ? w : 0.0;
-      take[x] += alpha != f ? w : 0.0;
-    }
-    else if (a == b)
-    {
-      g.add_edge(id[p], id[q], w, w);
-    }
-    else
-    {
-      // Keep/keep pays w (a != b), keep/alpha w, alpha/keep w, alpha/alpha 0.
-      keep[q] += w;
-      g.add_edge(id[p], id[q], w, 0.0);
-    }
-  });
+    pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
+      const double w = pr.Weight[k];
+      const int a = label[p], b = label[q];
+      if (w == 0.0 || (id[p] < 0 && id[q] < 0))
+      {
+        return;
+      }
+      if (id[p] < 0 || id[q] < 0)
+      {
+        // One end fixed at its label f: the other pays w when its choice differs from f.
+        const std::int64_t x = id[p] < 0 ? q : p;
+        const int f = id[p] < 0 ? a : b;
+        const int own = id[p] < 0 ? b : a;
+        keep[x] += own != f ? w : 0.0;
+        take[x] += alpha != f ? w : 0.0;
+      }
+      else if (a == b)
+      {
+        g.add_edge(id[p], id[q], w, w);
+      }
+      else
+      {
+        // Keep/keep pays w (a != b), keep/alpha w, alpha/keep w, alpha/alpha 0.
+        keep[q] += w;
+        g.add_edge(id[p], id[q], w, 0.0);
+      }
+    });
   }
   for (std::int64_t p = 0; p < n; ++p)
   {

@@ -388,7 +388,7 @@ bool GroupVoxelValues(const std::int32_t* owner, const T* values, std::int64_t v
   grouped.ValueType = VoxelTypeIndex<T>();
   grouped.Voxels = voxels;
   grouped.Nodes = nodes;
-  const std::array<double, 2> range = StridedRange(values, voxels);
+  const std::array<double, 2> range = HistogramRange(values, voxels);
   grouped.Low = range[0];
   grouped.High = range[1];
   grouped.Keep = std::move(keep);
@@ -739,10 +739,8 @@ HistogramLattice MakeHistogramLattice(const CutProblem& pr, const BoykovJollyPar
   const std::int64_t n = static_cast<std::int64_t>(pr.Value.size());
   const NodeVoxelValues* exact = pr.NodeVoxels;
   const std::array<double, 2> range =
-    exact ? std::array<double, 2>{ { exact->Low, exact->High } } : StridedRange(pr.Value.data(), n);
-  const double low = range[0];
-  double high = range[1];
-  high = high > low ? high : low + 1.0;
+    exact ? std::array<double, 2>{ { exact->Low, exact->High } } : HistogramRange(pr.Value.data(), n);
+  const double low = range[0], high = range[1];
   const int base = par.Bins > 0
     ? par.Bins
     : AutomaticBins({ { &pr.ObjectSamples, &pr.ObjectWeights }, { &pr.BackgroundSamples, &pr.BackgroundWeights } }, low,

@@ -20,14 +20,6 @@ double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 // abdomen's organs and 4 allowed no better fit than 2 (docs/multilabel.md).
 constexpr int MixtureComponents = 4;
 
-// Channel c's histogram range: its 0.5 and 99.5 percentiles, one unit wide when they meet.
-template <typename T>
-std::array<double, 2> ChannelRange(const T* values, int channels, int c, std::int64_t voxels)
-{
-  const std::array<double, 2> range = StridedRange(values, voxels, channels, c);
-  return { { range[0], range[1] > range[0] ? range[1] : range[0] + 1.0 } };
-}
-
 // A Gaussian blur of `grid` (PerChannel^channels bins) along `axis`, sigma `h` bins, truncated at 3h.
 void BlurAxis(std::vector<double>& grid, int perChannel, int channels, int axis, double h)
 {
@@ -453,7 +445,7 @@ bool BinChannels(const T* values, int channels, std::int64_t voxels, int bins, C
   out.PerChannel = BinsPerChannel(channels, bins);
   for (int c = 0; c < channels; ++c)
   {
-    const std::array<double, 2> range = ChannelRange(values, channels, c, voxels);
+    const std::array<double, 2> range = HistogramRange(values, voxels, channels, c);
     out.Low.push_back(range[0]);
     out.High.push_back(range[1]);
     out.Width.push_back((range[1] - range[0]) / out.PerChannel);
@@ -520,7 +512,7 @@ int SeedBinsPerChannel(const T* values, int channels, const ImageGeometry& g, co
   // The range the image was binned with, else the same percentiles afresh.
   const std::array<double, 2> range = binned && binned->Channels == 1 && binned->High.size() == 1
     ? std::array<double, 2>{ { binned->Low[0], binned->High[0] } }
-    : ChannelRange(values, 1, 0, g.Size());
+    : HistogramRange(values, g.Size());
   std::vector<WeightedSamples> sets;
   for (const std::vector<double>& s : samples)
   {

@@ -69,12 +69,13 @@ struct VoxelRefinementResult
 // What a refinement keeps for the next (a seed edit's re-cut) of one mesh and image: a map of the
 // image's voxels to the domain (4 bytes per voxel of the slices it spans), the domain (the band's
 // voxels, and those of elements in an earlier band, held at their elements' labels) with its voxel
-// faces and weights, and the solver's state. The next refinement adds the new band's voxels outside the domain to it while
-// the domain holds at most 1.5 times the band's elements, else builds it again. Two labels: the
-// max-flow graphs with their flow, whose terminal capacities move and whose flow runs on (Kohli &
-// Torr; one graph only); its labels are a fresh refinement's, as a node's label depends only on the
-// maximum flow's residual graph. More labels: the expansion's memory and, while the faces stay, its
-// rows of edges; each move's optimum is a fresh band's (held voxels are hard nodes).
+// faces and weights, and the solver's state. The next refinement adds the new band's voxels outside
+// the domain to it while the domain holds at most 1.5 times the band's elements, else builds it
+// again. Two labels: the max-flow graphs with their flow, whose terminal capacities move and whose
+// flow runs on (Kohli & Torr; one graph only); its labels are a fresh refinement's, as a node's
+// label depends only on the maximum flow's residual graph. More labels: the expansion's memory and,
+// while the faces stay, its rows of edges; each move's optimum is a fresh band's (held voxels are
+// hard nodes).
 class VoxelRefinementCache
 {
 public:
