@@ -681,6 +681,7 @@ void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
      << indent << "ScaleByContact: " << this->ScaleByContact << "\n"
      << indent << "VoxelRegionTerm: " << this->VoxelRegionTerm << "\n"
      << indent << "SampleSeedElements: " << this->SampleSeedElements << "\n"
+     << indent << "SeedElementRadius: " << this->SeedElementRadius << "\n"
      << indent << "VoxelRefinement: " << this->VoxelRefinement << "\n"
      << indent << "SeedRadius: " << this->SeedRadius << "\n"
      << indent << "SeedLabelArray: " << this->SeedLabelArray << "\n"

@@ -97,12 +97,18 @@ public:
   vtkSetMacro(VoxelRegionTerm, bool);
   vtkGetMacro(VoxelRegionTerm, bool);
   vtkBooleanMacro(VoxelRegionTerm, bool);
-  /// With the Image connected: the histograms sample the voxels of the seed elements (on), or the
-  /// voxels within SeedRadius of each seed, as the Voxel Cut does (off). Labelled seeds of several
-  /// objects, or several channels, always take the latter.
+  /// With the Image connected: the histograms sample the voxels of the seed elements within
+  /// SeedElementRadius of their seeds (on), or the voxels within SeedRadius of each seed, as the
+  /// Voxel Cut does (off). Labelled seeds of several objects, or several channels, always take the
+  /// latter.
   vtkSetMacro(SampleSeedElements, bool);
   vtkGetMacro(SampleSeedElements, bool);
   vtkBooleanMacro(SampleSeedElements, bool);
+  /// With SampleSeedElements: only the seed elements' voxels within this distance (voxels) of a
+  /// seed of their kind (default 5); 0 every voxel of the seed elements. Beyond [0, 50]: an error
+  /// at execution.
+  vtkSetMacro(SeedElementRadius, double);
+  vtkGetMacro(SeedElementRadius, double);
   /// Adds ElementId (the element owning each voxel, -1 none) to the label image: the mesh as a
   /// super-voxel label image (default off).
   vtkSetMacro(SuperVoxelIds, bool);

@@ -44,7 +44,8 @@ def cell_array(data, names):
 
 
 # Properties the Super-Voxel Cut has and the Voxel Cut has not: --cut passes them to the first only.
-SUPER_VOXEL_ONLY = ("VoxelRefinement", "ScaleByContact", "VoxelRegionTerm", "SampleSeedElements", "SuperVoxelIds")
+SUPER_VOXEL_ONLY = ("VoxelRefinement", "ScaleByContact", "VoxelRegionTerm", "SampleSeedElements", "SeedElementRadius",
+                    "SuperVoxelIds")
 
 
 def owners(proxy):

@@ -953,6 +953,21 @@ TEST(SuperVoxelCut, SeedRadiusOutOfRange)
       f->SetSeedRadius(-1);
     });
 }
+TEST(SuperVoxelCut, SeedElementRadiusOutOfRange)
+{
+  Case2D c;
+  for (const double radius : { -1.0, 51.0, std::nan("") })
+    SuperVoxelCut(c.mesh, c.object, c.background, c.image,
+      [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "seed element radius"); },
+      [radius](vtkSuperVoxelCut* f) { f->SetSeedElementRadius(radius); });
+}
+TEST(SuperVoxelCut, SeedElementRadiusZeroSamplesWholeElements)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image,
+    [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, c.image, c.object, c.background); },
+    [](vtkSuperVoxelCut* f) { f->SetSeedElementRadius(0); });
+}
 TEST(SuperVoxelCut, VoxelRefinementOutOfRange)
 {
   Case2D c;

@@ -62,6 +62,31 @@ std::vector<std::uint8_t> BorderVoxels(const ImageGeometry& g)
 
 namespace
 {
+// Appends, in raster order, the values of the voxels within `radius` of a seed of `kind` that lie in
+// an element holding seeds of that kind: a seed element samples what lies around its seeds, not
+// what a long Delaunay element reaches far from them (docs/cut.md).
+void SeedElementSamples(const VoxelValueFunction& value, const ImageGeometry& g, const VoxelOwnerMap& owner,
+  const std::vector<std::uint8_t>& hard, const std::vector<std::int64_t>& seedVoxels, std::uint8_t kind, double radius,
+  std::vector<double>& samples)
+{
+  std::vector<std::int64_t> voxels;
+  for (std::int64_t v : seedVoxels)
+  {
+    ForEachVoxelWithin(g, v, radius, [&](std::int64_t u) {
+      if (owner[u] >= 0 && hard[owner[u]] == kind)
+      {
+        voxels.push_back(u);
+      }
+    });
+  }
+  std::sort(voxels.begin(), voxels.end());
+  voxels.erase(std::unique(voxels.begin(), voxels.end()), voxels.end());
+  for (std::int64_t u : voxels)
+  {
+    samples.push_back(value(u));
+  }
+}
+
 // Appends the values of the voxels `owner` gives to element e, in raster order.
 void ElementVoxelValues(const SimplexMesh& mesh, const VoxelOwnerMap& owner, const NodeVoxelValues& voxels,
   std::int64_t e, std::vector<double>& out)
@@ -174,7 +199,14 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   if (data.HasVoxelValues())
   {
     const NodeVoxelValues& grouped = data.Voxels;
-    if (SamplesSeedElements(parameters) || !voxelValue)
+    if (SamplesSeedElements(parameters) && parameters.SeedElementRadius > 0.0 && voxelValue)
+    {
+      SeedElementSamples(voxelValue, mesh.Geometry(), owner, pr.Hard, objectVoxels, 1, parameters.SeedElementRadius,
+        pr.ObjectSamples);
+      SeedElementSamples(voxelValue, mesh.Geometry(), owner, pr.Hard, backgroundVoxels, 2,
+        parameters.SeedElementRadius, pr.BackgroundSamples);
+    }
+    else if (SamplesSeedElements(parameters) || !voxelValue)
     {
       for (std::int64_t e = 0; e < m; ++e)
       {
@@ -359,6 +391,10 @@ std::string ValidateParameters(const SeededCutParameters& p)
 std::string ValidateParameters(const SuperVoxelCutParameters& p)
 {
   std::string error = ValidateParameters(static_cast<const SeededCutParameters&>(p));
+  if (error.empty() && !(p.SeedElementRadius >= 0.0 && p.SeedElementRadius <= 50.0))
+  {
+    error = "the seed element radius must lie in [0, 50] voxels.";
+  }
   if (error.empty() && !(p.VoxelRefinement >= 0 && p.VoxelRefinement <= 8))
   {
     error = "the voxel refinement must lie in [0, 8] rings of elements.";

@@ -72,6 +72,10 @@ struct SuperVoxelCutParameters : SeededCutParameters
   // too few samples of it. So do labelled seeds of several objects or channels, where the seed
   // elements' voxels made the worse model (docs/multilabel.md).
   bool SampleSeedElements = true;
+  // With SampleSeedElements: only the seed elements' voxels within this distance (voxels) of a seed
+  // of their kind; 0 every voxel of theirs. The Delaunay mesh's long seed elements reach past the
+  // object; the smoothed mesh's compact ones mostly lie within it (docs/cut.md).
+  double SeedElementRadius = 5.0;
   // Rings of elements along the cut whose voxels are labelled again by the voxel cut's energy
   // (VoxelRefinement.h): 1 the elements with a neighbour of another label, each more ring their
   // neighbours too (2 by default: docs/cut.md); 0 off. The label image then follows the voxels
