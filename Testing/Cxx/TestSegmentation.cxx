@@ -410,6 +410,59 @@ TEST(BoykovJolly, KeptCutsEqualFreshCuts)
   }
 }
 
+TEST(SuperVoxelCut, SeedElementVoxelsAreTheSeedElementsVoxelsNearASeed)
+{
+  // A random owner map with a few seed elements of each kind: the voxels SeedElementVoxels lists are
+  // those of the kind's seed elements within the radius of one of its seeds, in raster order, from
+  // few seeds (listed balls) and from a scribble of many (a mask over their box), in 3D and 2D.
+  for (const int depth : { 24, 1 })
+  {
+    ImageGeometry g;
+    g.Dims = { { 40, 36, depth } };
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<std::int32_t> element(0, 59);
+    std::vector<std::int32_t> owner(g.Size());
+    for (auto& o : owner)
+      o = element(rng);
+    owner[5] = -1;
+    std::vector<std::uint8_t> hard(60, 0);
+    for (int e = 0; e < 60; e += 7)
+      hard[e] = e % 2 ? 1 : 2;
+    std::uniform_int_distribution<std::int64_t> voxel(0, g.Size() - 1);
+    for (const int seeds : { 3, 400 })
+    {
+      std::vector<std::int64_t> object;
+      for (int n = 0; n < seeds; ++n)
+        object.push_back(seeds > 100 ? g.Index(10 + n % 12, 8 + (n / 12) % 10, std::min(depth - 1, n / 120)) : voxel(rng));
+      object.push_back(object.front()); // a repeated seed counts once
+      for (const double radius : { 2.5, 5.0 })
+      {
+        std::vector<std::int64_t> expected;
+        for (std::int64_t u = 0; u < g.Size(); ++u)
+        {
+          if (owner[u] < 0 || hard[owner[u]] != 1)
+            continue;
+          const int i = static_cast<int>(u % g.Dims[0]), j = static_cast<int>((u % g.SliceStride()) / g.Dims[0]),
+                    k = static_cast<int>(u / g.SliceStride());
+          for (const std::int64_t v : object)
+          {
+            const int di = i - static_cast<int>(v % g.Dims[0]), dj = j - static_cast<int>((v % g.SliceStride()) / g.Dims[0]),
+                      dk = k - static_cast<int>(v / g.SliceStride());
+            if (di * di + dj * dj + dk * dk <= radius * radius)
+            {
+              expected.push_back(u);
+              break;
+            }
+          }
+        }
+        EXPECT_FALSE(expected.empty());
+        EXPECT_EQ(SeedElementVoxels(g, owner.data(), hard, object, 1, radius), expected)
+          << depth << " slices, " << seeds << " seeds, radius " << radius;
+      }
+    }
+  }
+}
+
 TEST(SuperVoxelCut, BoundedVoxelValuesCutAsSortedOnes)
 {
   // A noisy bright ball in a 3D image, meshed off the lattice: the cut with each element's voxel

@@ -47,6 +47,77 @@ void SeedNeighbourhoodSamples(const VoxelValueFunction& value, const ImageGeomet
   }
 }
 
+// Few seeds list their balls' voxels and sort them; many (a scribble) mark them in a mask over the
+// balls' bounding box.
+std::vector<std::int64_t> SeedElementVoxels(const ImageGeometry& g, const std::int32_t* owner,
+  const std::vector<std::uint8_t>& hard, std::vector<std::int64_t> seedVoxels, std::uint8_t kind, double radius)
+{
+  std::vector<std::int64_t> voxels;
+  std::sort(seedVoxels.begin(), seedVoxels.end());
+  seedVoxels.erase(std::unique(seedVoxels.begin(), seedVoxels.end()), seedVoxels.end());
+  if (seedVoxels.empty())
+  {
+    return voxels;
+  }
+  const int r = static_cast<int>(std::floor(radius));
+  std::array<int, 3> lo = g.Dims, hi{ { -1, -1, -1 } };
+  for (std::int64_t v : seedVoxels)
+  {
+    const std::array<int, 3> ijk{ { static_cast<int>(v % g.Dims[0]), static_cast<int>((v % g.SliceStride()) / g.Dims[0]),
+      static_cast<int>(v / g.SliceStride()) } };
+    for (int a = 0; a < 3; ++a)
+    {
+      const int reach = a == 2 && g.Is2D() ? 0 : r;
+      lo[a] = std::min(lo[a], std::max(0, ijk[a] - reach));
+      hi[a] = std::max(hi[a], std::min(g.Dims[a] - 1, ijk[a] + reach));
+    }
+  }
+  const std::int64_t nx = hi[0] - lo[0] + 1, ny = hi[1] - lo[1] + 1, nz = hi[2] - lo[2] + 1;
+  const std::int64_t box = nx * ny * nz;
+  const std::int64_t ball = static_cast<std::int64_t>(2 * r + 1) * (2 * r + 1) * (g.Is2D() ? 1 : 2 * r + 1);
+  auto take = [&](std::int64_t u) { return owner[u] >= 0 && hard[owner[u]] == kind; };
+  if (static_cast<std::int64_t>(seedVoxels.size()) * ball <= box / 16)
+  {
+    for (std::int64_t v : seedVoxels)
+    {
+      ForEachVoxelWithin(g, v, radius, [&](std::int64_t u) {
+        if (take(u))
+        {
+          voxels.push_back(u);
+        }
+      });
+    }
+    std::sort(voxels.begin(), voxels.end());
+    voxels.erase(std::unique(voxels.begin(), voxels.end()), voxels.end());
+    return voxels;
+  }
+  std::vector<std::uint8_t> mask(static_cast<std::size_t>(box), 0);
+  for (std::int64_t v : seedVoxels)
+  {
+    ForEachVoxelWithin(g, v, radius, [&](std::int64_t u) {
+      const std::int64_t i = u % g.Dims[0] - lo[0], j = (u % g.SliceStride()) / g.Dims[0] - lo[1],
+                         k = u / g.SliceStride() - lo[2];
+      mask[static_cast<std::size_t>((k * ny + j) * nx + i)] = 1;
+    });
+  }
+  for (std::int64_t k = 0; k < nz; ++k)
+  {
+    for (std::int64_t j = 0; j < ny; ++j)
+    {
+      const std::uint8_t* row = mask.data() + (k * ny + j) * nx;
+      const std::int64_t first = g.Index(lo[0], lo[1] + static_cast<int>(j), lo[2] + static_cast<int>(k));
+      for (std::int64_t i = 0; i < nx; ++i)
+      {
+        if (row[i] && take(first + i))
+        {
+          voxels.push_back(first + i);
+        }
+      }
+    }
+  }
+  return voxels;
+}
+
 std::vector<std::uint8_t> BorderVoxels(const ImageGeometry& g)
 {
   std::vector<std::uint8_t> border(g.Size(), 0);
@@ -62,31 +133,6 @@ std::vector<std::uint8_t> BorderVoxels(const ImageGeometry& g)
 
 namespace
 {
-// Appends, in raster order, the values of the voxels within `radius` of a seed of `kind` that lie in
-// an element holding seeds of that kind: a seed element samples what lies around its seeds, not
-// what a long Delaunay element reaches far from them (docs/cut.md).
-void SeedElementSamples(const VoxelValueFunction& value, const ImageGeometry& g, const VoxelOwnerMap& owner,
-  const std::vector<std::uint8_t>& hard, const std::vector<std::int64_t>& seedVoxels, std::uint8_t kind, double radius,
-  std::vector<double>& samples)
-{
-  std::vector<std::int64_t> voxels;
-  for (std::int64_t v : seedVoxels)
-  {
-    ForEachVoxelWithin(g, v, radius, [&](std::int64_t u) {
-      if (owner[u] >= 0 && hard[owner[u]] == kind)
-      {
-        voxels.push_back(u);
-      }
-    });
-  }
-  std::sort(voxels.begin(), voxels.end());
-  voxels.erase(std::unique(voxels.begin(), voxels.end()), voxels.end());
-  for (std::int64_t u : voxels)
-  {
-    samples.push_back(value(u));
-  }
-}
-
 // Appends the values of the voxels `owner` gives to element e, in raster order.
 void ElementVoxelValues(const SimplexMesh& mesh, const VoxelOwnerMap& owner, const NodeVoxelValues& voxels,
   std::int64_t e, std::vector<double>& out)
@@ -201,10 +247,15 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
     const NodeVoxelValues& grouped = data.Voxels;
     if (SamplesSeedElements(parameters) && parameters.SeedElementRadius > 0.0 && voxelValue)
     {
-      SeedElementSamples(voxelValue, mesh.Geometry(), owner, pr.Hard, objectVoxels, 1, parameters.SeedElementRadius,
-        pr.ObjectSamples);
-      SeedElementSamples(voxelValue, mesh.Geometry(), owner, pr.Hard, backgroundVoxels, 2,
-        parameters.SeedElementRadius, pr.BackgroundSamples);
+      for (const std::uint8_t kind : { 1, 2 })
+      {
+        std::vector<double>& samples = kind == 1 ? pr.ObjectSamples : pr.BackgroundSamples;
+        for (const std::int64_t u : SeedElementVoxels(mesh.Geometry(), owner.data(), pr.Hard,
+               kind == 1 ? objectVoxels : backgroundVoxels, kind, parameters.SeedElementRadius))
+        {
+          samples.push_back(voxelValue(u));
+        }
+      }
     }
     else if (SamplesSeedElements(parameters) || !voxelValue)
     {

@@ -196,6 +196,12 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& geometry,
 std::string ValidateParameters(const SeededCutParameters& p);
 std::string ValidateParameters(const SuperVoxelCutParameters& p);
 
+// The voxels within `radius` (voxels) of a seed voxel that `owner` gives to an element whose `hard`
+// is `kind` (the elements holding seeds of that kind), in raster order: what the seed elements
+// sample with SeedElementRadius.
+std::vector<std::int64_t> SeedElementVoxels(const ImageGeometry& g, const std::int32_t* owner,
+  const std::vector<std::uint8_t>& hard, std::vector<std::int64_t> seedVoxels, std::uint8_t kind, double radius);
+
 // f(voxel) for each voxel within `radius` (voxels, index space) of voxel v, the image's own in 2D.
 template <typename F>
 void ForEachVoxelWithin(const ImageGeometry& g, std::int64_t v, double radius, F&& f)
