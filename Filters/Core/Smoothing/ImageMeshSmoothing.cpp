@@ -875,25 +875,27 @@ bool RestoreDelaunay(Smoother& s, const std::vector<std::uint8_t>& moved, std::v
 {
   const ImageGeometry& g = s.Topology.Geometry();
   const int vpc = s.Topology.VerticesPerCell();
-  std::vector<std::int64_t> cells = s.Topology.Cells();
+  std::vector<std::int64_t> cells;
   if (vpc == 3)
   {
+    cells = s.Topology.Cells();
     flips += DelaunayFlips(g, s.Points, moved, cells, neighbours);
   }
   else
   {
     std::vector<V3> frame(s.Points.size());
     std::transform(s.Points.begin(), s.Points.end(), frame.begin(), [&](const V3& q) { return g.IndexToFrame(q); });
+    const std::size_t nodes = frame.size();
     DelaunayImageMeshParameters o;
     o.Backend = DelaunayBackend::CGAL;
     // CGAL has no progress or abort of its own: it runs beside a heartbeat.
     DelaunayResult d;
-    if (!RunWithHeartbeat<DelaunayResult>([frame, o]() { return Tetrahedralize(frame, o); }, progress, d))
+    if (!RunWithHeartbeat<DelaunayResult>([frame = std::move(frame), o]() { return Tetrahedralize(frame, o); }, progress, d))
     {
       aborted = true;
       return false;
     }
-    if (!d.Error.empty() || d.Points.size() != frame.size())
+    if (!d.Error.empty() || d.Points.size() != nodes)
     {
       error = "re-tetrahedralising the moved nodes failed: " + d.Error;
       return false;
@@ -926,24 +928,27 @@ bool RefineQuality(Smoother& s, const std::vector<std::uint8_t>& fixed, const Im
   o.PreserveBoundary = true;
   const double minAngle = p.MinAngle;
   const bool planar = vpc == 3;
+  const std::size_t nodes = frame.size();
   // TetGen and CGAL's mesher have no progress or abort of their own: they run beside a heartbeat.
   DelaunayResult d;
   if (!RunWithHeartbeat<DelaunayResult>(
-        [frame, o, minAngle, planar]() { return planar ? RefineQuality2D(frame, minAngle) : Tetrahedralize(frame, o); },
+        [frame = std::move(frame), o, minAngle, planar]() {
+          return planar ? RefineQuality2D(frame, minAngle) : Tetrahedralize(frame, o);
+        },
         progress, d))
   {
     result.Aborted = true;
     return false;
   }
-  if (!d.Error.empty() || d.Points.size() < frame.size())
+  if (!d.Error.empty() || d.Points.size() < nodes)
   {
     result.Error = "quality refinement failed: " + d.Error;
     return false;
   }
   ++result.RefinementRuns;
-  result.AddedNodes = static_cast<std::int64_t>(d.Points.size() - frame.size());
+  result.AddedNodes = static_cast<std::int64_t>(d.Points.size() - nodes);
   std::vector<V3> index = s.Points;
-  for (size_t i = frame.size(); i < d.Points.size(); ++i)
+  for (size_t i = nodes; i < d.Points.size(); ++i)
   {
     index.push_back(g.FrameToIndex(d.Points[i]));
   }
