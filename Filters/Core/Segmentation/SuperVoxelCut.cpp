@@ -63,8 +63,7 @@ std::vector<std::int64_t> SeedElementVoxels(const ImageGeometry& g, const std::i
   std::array<int, 3> lo = g.Dims, hi{ { -1, -1, -1 } };
   for (std::int64_t v : seedVoxels)
   {
-    const std::array<int, 3> ijk{ { static_cast<int>(v % g.Dims[0]), static_cast<int>((v % g.SliceStride()) / g.Dims[0]),
-      static_cast<int>(v / g.SliceStride()) } };
+    const std::array<int, 3> ijk = g.Coordinates(v);
     for (int a = 0; a < 3; ++a)
     {
       const int reach = a == 2 && g.Is2D() ? 0 : r;
@@ -95,9 +94,8 @@ std::vector<std::int64_t> SeedElementVoxels(const ImageGeometry& g, const std::i
   for (std::int64_t v : seedVoxels)
   {
     ForEachVoxelWithin(g, v, radius, [&](std::int64_t u) {
-      const std::int64_t i = u % g.Dims[0] - lo[0], j = (u % g.SliceStride()) / g.Dims[0] - lo[1],
-                         k = u / g.SliceStride() - lo[2];
-      mask[static_cast<std::size_t>((k * ny + j) * nx + i)] = 1;
+      const std::array<int, 3> c = g.Coordinates(u);
+      mask[static_cast<std::size_t>(((c[2] - lo[2]) * ny + (c[1] - lo[1])) * nx + (c[0] - lo[0]))] = 1;
     });
   }
   for (std::int64_t k = 0; k < nz; ++k)
