@@ -340,6 +340,25 @@ def bending(surface):
     return float(np.degrees(np.arccos(cosines)).mean()) if len(a) else float("nan")
 
 
+def draw_seeds(truth, n_object, n_background, rng, erosion=2.0, band=(3.0, 15.0)):
+    """New seeds as the shared data's generator draws them (its README): object seeds at random from
+    the reference eroded by `erosion` voxels, background seeds from the band `band` voxels around it
+    (Euclidean distances in voxels). Returns (object, background) lists of (i, j, k) indices."""
+    volume = truth.reshape(truth.shape if truth.ndim == 3 else (1,) + truth.shape).astype(bool)
+    flat = _squeeze(volume)
+    inside = ndi.distance_transform_edt(flat)
+    outside = ndi.distance_transform_edt(~flat)
+    picks = []
+    for where, n in ((inside > erosion, n_object), ((outside >= band[0]) & (outside <= band[1]), n_background)):
+        candidates = np.flatnonzero(where.reshape(volume.shape))
+        if len(candidates) < n:
+            raise ValueError("only %d candidate voxels for %d seeds" % (len(candidates), n))
+        chosen = np.sort(rng.choice(candidates, size=n, replace=False))
+        k, j, i = np.unravel_index(chosen, volume.shape)
+        picks.append([(int(a), int(b), int(c)) for a, b, c in zip(i, j, k)])
+    return picks[0], picks[1]
+
+
 def next_seed(result, truth, spacing):
     """(index (k, j, i), is_object) of the robot user's next seed (benchmark_clicks.py): the most interior
     voxel of the largest error region of `result` against `truth` (boolean arrays), or None when the

@@ -1,0 +1,129 @@
+"""Other seeds on the same cases (pvpython): how the defaults hold on seeds they were not chosen on.
+
+usage: pvpython scripts/benchmark_seeds.py [--draws 5] [--cases a,b] [--methods supervoxel,voxel,random_walker,watershed]
+                                           [--cut SeedElementRadius=0] [--generator 0] [--out out/benchmark_seeds]
+The shared seed files are one draw of a fixed generator (the shared data's README: object seeds at
+random from the reference eroded by 2 voxels, background seeds from the band 3-15 voxels around it).
+Every default was measured on those files; cases that are not shared come with their own draw. This
+benchmark draws --draws new seed sets per case the same way (as many seeds of each kind as the
+files hold; metrics.draw_seeds, numpy's generator seeded by --generator and the case's name) and
+runs each method on each, with the case's task. Draw 0 is the seed files. The super-voxel cut
+re-cuts one mesh per case (stages 1 -> 2 -> 3 do not read the seeds); the other methods run afresh.
+
+Per case and method: Dice on the files, the mean, smallest and largest over the new draws, and on
+how many draws the super-voxel cut is at least the method's Dice (at least the voxel cut's - 0.01
+for the voxel cut, issue 26's rule). Writes OUT.md and OUT.csv (a row per case, draw and method).
+"""
+import argparse
+import csv
+import os
+import zlib
+
+import numpy as np
+
+import featuremesh as fm
+from featuremesh import metrics, report
+from benchmark_clicks import METHODS, Loop
+
+
+def file_seeds(case, image):
+    origin, spacing = np.array(image.GetOrigin()), np.array(image.GetSpacing())
+    out = []
+    for name in ("seeds_object.csv", "seeds_background.csv"):
+        pts = np.loadtxt(os.path.join(case.folder, name), delimiter=",", skiprows=1, ndmin=2)
+        out.append([tuple(int(v) for v in s) for s in np.rint((pts - origin) / spacing)])
+    return out
+
+
+def run_case(case, methods, draws, generator, cut):
+    image = fm.fetch(case.image)
+    shape = image.GetDimensions()[::-1]
+    truth = case.truth().reshape(shape).astype(bool)
+    files = file_seeds(case, image)
+    rng = np.random.default_rng([generator, zlib.crc32(case.name.encode())])
+    seed_sets = [files] + [metrics.draw_seeds(truth, len(files[0]), len(files[1]), rng) for _ in range(draws)]
+    rows = []
+    for method in methods:
+        loop = Loop(method, case, image, cut if method == "supervoxel" else None)
+        for d, (obj, bg) in enumerate(seed_sets):
+            mask, seconds = loop.segment(obj, bg)
+            rows.append({"case": case.name, "task": case.task or "", "draw": d, "method": method,
+                         "dice": fm.dice(mask, truth), "seconds": seconds})
+            print("%s draw %d %s: Dice %.3f (%.2f s)" % (case.name, d, method, rows[-1]["dice"], seconds), flush=True)
+        loop.close()
+    return rows
+
+
+def summary(rows, methods):
+    """Markdown lines: per case and method the files' Dice, the new draws' mean / min / max, and the
+    draws on which the super-voxel cut holds against the method."""
+    lines = ["| case | task | method | seed files | new draws: mean | min | max | super-voxel holds |",
+             "|---|---|---|---|---|---|---|---|"]
+    cases = list(dict.fromkeys(r["case"] for r in rows))
+    for name in cases:
+        by = {(r["method"], r["draw"]): r["dice"] for r in rows if r["case"] == name}
+        draws = sorted({d for (_, d) in by if d > 0})
+        task = next(r["task"] for r in rows if r["case"] == name)
+        for method in methods:
+            new = [by[(method, d)] for d in draws if (method, d) in by]
+            holds = ""
+            if method != "supervoxel" and ("supervoxel", 0) in by and new:
+                margin = 0.01 if method == "voxel" else 0.0
+                won = sum(by[("supervoxel", d)] >= by[(method, d)] - margin for d in draws)
+                holds = "%d of %d" % (won, len(draws))
+            lines.append("| %s | %s | %s | %.3f | %s | %s | %s | %s |" % (
+                name, task, method, by.get((method, 0), float("nan")),
+                "%.3f" % np.mean(new) if new else "", "%.3f" % min(new) if new else "",
+                "%.3f" % max(new) if new else "", holds))
+    lines += ["", "| task | method | mean Dice, seed files | mean Dice, new draws |", "|---|---|---|---|"]
+    for task in sorted({r["task"] for r in rows}):
+        for method in methods:
+            sel = [r for r in rows if r["task"] == task and r["method"] == method]
+            if sel:
+                lines.append("| %s | %s | %.3f | %.3f |" % (
+                    task, method, np.mean([r["dice"] for r in sel if r["draw"] == 0]),
+                    np.mean([r["dice"] for r in sel if r["draw"] > 0] or [float("nan")])))
+    return lines
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--draws", type=int, default=5)
+    ap.add_argument("--generator", type=int, default=0)
+    ap.add_argument("--cases", default="")
+    ap.add_argument("--methods", default=",".join(METHODS))
+    ap.add_argument("--cut", default="", type=fm.parse_properties,
+                    help="properties of the Super-Voxel Cut, e.g. SeedElementRadius=0")
+    ap.add_argument("--out", default=os.path.join(fm.ROOT, "out", "benchmark_seeds"))
+    args = ap.parse_args()
+    methods = [m for m in args.methods.split(",") if m]
+    unknown = [m for m in methods if m not in METHODS]
+    if unknown:
+        raise SystemExit("unknown methods: %s (choose from %s)" % (", ".join(unknown), ", ".join(METHODS)))
+    if args.draws < 0:
+        raise SystemExit("--draws must be 0 or more")
+    fm.load_plugin()
+    if not os.path.isdir(os.path.join(fm.SHARED, "cases")):
+        print("shared data not found at %s: only the bundled cases run" % fm.SHARED)
+    rows = []
+    for name, folder in fm.cases(args.cases).items():
+        case = fm.Case(folder)
+        if case.truth() is None:
+            print("%s: no truth.mha, skipped" % name)
+            continue
+        rows += run_case(case, methods, args.draws, args.generator, args.cut)
+    os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
+    with open(args.out + ".csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["case", "task", "draw", "method", "dice", "seconds"])
+        for r in rows:
+            w.writerow([r["case"], r["task"], r["draw"], r["method"], "%.4f" % r["dice"], "%.3f" % r["seconds"]])
+    lines = ["Machine: %s; %d new seed draws per case (generator %d), draw 0 = the seed files." % (
+        report.machine(), args.draws, args.generator), ""] + summary(rows, methods)
+    with open(args.out + ".md", "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
