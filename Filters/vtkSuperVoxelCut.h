@@ -99,8 +99,8 @@ public:
   vtkBooleanMacro(VoxelRegionTerm, bool);
   /// With the Image connected: the histograms sample the voxels of the seed elements within
   /// SeedElementRadius of their seeds (on), or the voxels within SeedRadius of each seed, as the
-  /// Voxel Cut does (off). Labelled seeds of several objects, or several channels, always take the
-  /// latter.
+  /// Voxel Cut does (off, default). Labelled seeds of several objects, or several channels, always
+  /// take the latter.
   vtkSetMacro(SampleSeedElements, bool);
   vtkGetMacro(SampleSeedElements, bool);
   vtkBooleanMacro(SampleSeedElements, bool);

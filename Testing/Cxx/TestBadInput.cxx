@@ -966,7 +966,10 @@ TEST(SuperVoxelCut, SeedElementRadiusZeroSamplesWholeElements)
   Case2D c;
   SuperVoxelCut(c.mesh, c.object, c.background, c.image,
     [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, c.image, c.object, c.background); },
-    [](vtkSuperVoxelCut* f) { f->SetSeedElementRadius(0); });
+    [](vtkSuperVoxelCut* f) {
+      f->SampleSeedElementsOn();
+      f->SetSeedElementRadius(0);
+    });
 }
 TEST(SuperVoxelCut, VoxelRefinementOutOfRange)
 {

@@ -67,11 +67,10 @@ struct SuperVoxelCutParameters : SeededCutParameters
   // its voxel count times the cost of its mean.
   bool VoxelRegionTerm = true;
   // The histograms' samples: the voxels of the elements that hold seeds (true), or those within
-  // SeedRadius of each seed voxel, as the voxel cut (false). The local contrast always takes the
-  // latter: the elements follow the image's edges, not its contrast, and small seed elements give
-  // too few samples of it. So do labelled seeds of several objects or channels, where the seed
-  // elements' voxels made the worse model (docs/multilabel.md).
-  bool SampleSeedElements = true;
+  // SeedRadius of each seed voxel, as the voxel cut (false, default: on seeds drawn anew the seed
+  // elements' large, mixed elements made the worse model, docs/cut.md). The local contrast always
+  // takes the latter, and so do labelled seeds of several objects or channels.
+  bool SampleSeedElements = false;
   // With SampleSeedElements: only the seed elements' voxels within this distance (voxels) of a seed
   // of their kind; 0 every voxel of theirs. The Delaunay mesh's long seed elements reach past the
   // object; the smoothed mesh's compact ones mostly lie within it (docs/cut.md).
