@@ -340,23 +340,33 @@ def bending(surface):
     return float(np.degrees(np.arccos(cosines)).mean()) if len(a) else float("nan")
 
 
-def draw_seeds(truth, n_object, n_background, rng, erosion=2.0, band=(3.0, 15.0)):
-    """New seeds as the shared data's generator draws them (its README): object seeds at random from
-    the reference eroded by `erosion` voxels, background seeds from the band `band` voxels around it
-    (Euclidean distances in voxels). Returns (object, background) lists of (i, j, k) indices."""
-    volume = truth.reshape(truth.shape if truth.ndim == 3 else (1,) + truth.shape).astype(bool)
+def draw_labelled_seeds(labels, counts, rng, erosion=2.0, band=(3.0, 15.0)):
+    """New seeds as the shared data's generator draws them (its README): `counts[l]` seeds of each
+    label l > 0 at random from that label eroded by `erosion` voxels, `counts[0]` background seeds
+    from the band `band` voxels around the union of the labels (Euclidean distances in voxels).
+    `labels` is a label volume (0 background); returns {label: [(i, j, k), ...]}."""
+    volume = labels.reshape(labels.shape if labels.ndim == 3 else (1,) + labels.shape)
     flat = _squeeze(volume)
-    inside = ndi.distance_transform_edt(flat)
-    outside = ndi.distance_transform_edt(~flat)
-    picks = []
-    for where, n in ((inside > erosion, n_object), ((outside >= band[0]) & (outside <= band[1]), n_background)):
+    picks = {}
+    for label in sorted(l for l in counts if l > 0) + [0] * (0 in counts):
+        if label == 0:
+            outside = ndi.distance_transform_edt(flat == 0)
+            where = (outside >= band[0]) & (outside <= band[1])
+        else:
+            where = ndi.distance_transform_edt(flat == label) > erosion
         candidates = np.flatnonzero(where.reshape(volume.shape))
-        if len(candidates) < n:
-            raise ValueError("only %d candidate voxels for %d seeds" % (len(candidates), n))
-        chosen = np.sort(rng.choice(candidates, size=n, replace=False))
+        if len(candidates) < counts[label]:
+            raise ValueError("only %d candidate voxels for %d seeds of label %d" % (len(candidates), counts[label], label))
+        chosen = np.sort(rng.choice(candidates, size=counts[label], replace=False))
         k, j, i = np.unravel_index(chosen, volume.shape)
-        picks.append([(int(a), int(b), int(c)) for a, b, c in zip(i, j, k)])
-    return picks[0], picks[1]
+        picks[label] = [(int(a), int(b), int(c)) for a, b, c in zip(i, j, k)]
+    return picks
+
+
+def draw_seeds(truth, n_object, n_background, rng, erosion=2.0, band=(3.0, 15.0)):
+    """draw_labelled_seeds for one object (`truth` boolean): (object, background) lists of (i, j, k)."""
+    picks = draw_labelled_seeds(np.asarray(truth).astype(np.uint8), {1: n_object, 0: n_background}, rng, erosion, band)
+    return picks[1], picks[0]
 
 
 def next_seed(result, truth, spacing):
