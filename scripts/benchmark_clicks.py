@@ -33,6 +33,15 @@ from featuremesh import metrics, report
 METHODS = ("supervoxel", "voxel", "random_walker", "watershed")
 
 
+def parse_methods(text):
+    """The --methods list; exits with a message on an unknown name."""
+    methods = [m for m in text.split(",") if m]
+    unknown = [m for m in methods if m not in METHODS]
+    if unknown:
+        raise SystemExit("unknown methods: %s (choose from %s)" % (", ".join(unknown), ", ".join(METHODS)))
+    return methods
+
+
 class Loop:
     """One method's segmentation from (object, background) seed index lists ((i, j, k) each)."""
 
@@ -124,10 +133,7 @@ def main():
                     help="properties of the Super-Voxel Cut, e.g. VoxelRefinement=0")
     ap.add_argument("--out", default=os.path.join(fm.ROOT, "out", "benchmark_clicks"))
     args = ap.parse_args()
-    methods = [m for m in args.methods.split(",") if m]
-    unknown = [m for m in methods if m not in METHODS]
-    if unknown:
-        raise SystemExit("unknown methods: %s (choose from %s)" % (", ".join(unknown), ", ".join(METHODS)))
+    methods = parse_methods(args.methods)
     fm.load_plugin()
     if not os.path.isdir(os.path.join(fm.SHARED, "cases")):
         print("shared data not found at %s: only the bundled cases run" % fm.SHARED)

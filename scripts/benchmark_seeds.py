@@ -30,7 +30,7 @@ import numpy as np
 
 import featuremesh as fm
 from featuremesh import metrics, report
-from benchmark_clicks import METHODS, Loop
+from benchmark_clicks import METHODS, Loop, parse_methods
 import benchmark_multilabel as ml
 
 
@@ -159,10 +159,7 @@ def main():
                     help="properties of the Super-Voxel Cut, e.g. SeedElementRadius=0")
     ap.add_argument("--out", default=os.path.join(fm.ROOT, "out", "benchmark_seeds"))
     args = ap.parse_args()
-    methods = [m for m in args.methods.split(",") if m]
-    unknown = [m for m in methods if m not in METHODS]
-    if unknown:
-        raise SystemExit("unknown methods: %s (choose from %s)" % (", ".join(unknown), ", ".join(METHODS)))
+    methods = parse_methods(args.methods)
     if args.draws < 0:
         raise SystemExit("--draws must be 0 or more")
     fm.load_plugin()
