@@ -961,6 +961,13 @@ TEST(SuperVoxelCut, SeedElementRadiusOutOfRange)
       [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "seed element radius"); },
       [radius](vtkSuperVoxelCut* f) { f->SetSeedElementRadius(radius); });
 }
+TEST(SuperVoxelCut, SampleSeedElementsOnGivesACut)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image,
+    [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, c.image, c.object, c.background); },
+    [](vtkSuperVoxelCut* f) { f->SampleSeedElementsOn(); });
+}
 TEST(SuperVoxelCut, SeedElementRadiusZeroSamplesWholeElements)
 {
   Case2D c;
