@@ -278,14 +278,16 @@ double MoveChange(const PottsProblem& pr, int alpha, const std::vector<std::uint
 }
 
 // One alpha-expansion move on the graph g (reset here): the nodes it switches to alpha and the
-// energy change. Node p keeps its label and pays keep[p] (source segment), or takes alpha and pays
-// take[p] (sink). Fixed, and left out of the graph: nodes at alpha, hard nodes of another label, and
-// nodes whose cost of alpha exceeds their cost of keeping by at least their summed boundary weight
-// (no neighbours can make switching pay, so keeping is optimal: the move stays exact).
+// energy change. Free node p keeps its label and pays Keep[Id[p]] (source segment), or takes alpha
+// and pays Take[Id[p]] (sink); the loops after the first visit the free nodes only. Fixed, and left
+// out of the graph: nodes at alpha, hard nodes of another label, and nodes whose cost of alpha
+// exceeds their cost of keeping by at least their summed boundary weight (no neighbours can make
+// switching pay, so keeping is optimal: the move stays exact).
 struct MoveBuffers
 {
-  std::vector<double> Keep, Take;
-  std::vector<std::int32_t> Id; // a node's id in the move's graph, -1 when it is fixed
+  std::vector<double> Keep, Take; // by id in the move's graph
+  std::vector<std::int32_t> Id;   // a node's id in the move's graph, -1 when it is fixed
+  std::vector<std::int64_t> Free; // the free nodes in ascending order: Free[Id[p]] == p
 };
 double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::uint8_t>& label, const Neighbourhood& around,
   Flow& g, MoveBuffers& buffers, std::vector<std::int64_t>& switched)
@@ -295,26 +297,32 @@ double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::u
   std::vector<double>& keep = buffers.Keep;
   std::vector<double>& take = buffers.Take;
   std::vector<std::int32_t>& id = buffers.Id;
-  ResizeWithRoom(keep, n);
-  ResizeWithRoom(take, n);
+  std::vector<std::int64_t>& freeNodes = buffers.Free;
   ResizeWithRoom(id, n);
-  std::int32_t active = 0;
+  freeNodes.clear();
   for (std::int64_t p = 0; p < n; ++p)
   {
     const double* c = &pr.Cost[p * L];
-    keep[p] = take[p] = 0.0;
-    id[p] = -1;
-    if (label[p] != alpha && HardLabel(pr, p) < 0 && c[alpha] - c[label[p]] < around.Reach[p])
+    const bool isFree = label[p] != alpha && HardLabel(pr, p) < 0 && c[alpha] - c[label[p]] < around.Reach[p];
+    id[p] = isFree ? static_cast<std::int32_t>(freeNodes.size()) : -1;
+    if (isFree)
     {
-      keep[p] = c[label[p]];
-      take[p] = c[alpha];
-      id[p] = active++;
+      freeNodes.push_back(p);
     }
   }
+  const std::int32_t active = static_cast<std::int32_t>(freeNodes.size());
   switched.clear();
   if (active == 0)
   {
     return 0.0;
+  }
+  ResizeWithRoom(keep, active);
+  ResizeWithRoom(take, active);
+  for (std::int32_t a = 0; a < active; ++a)
+  {
+    const double* c = &pr.Cost[freeNodes[a] * L];
+    keep[a] = c[label[freeNodes[a]]];
+    take[a] = c[alpha];
   }
   g.reset();
   g.add_node(active);
@@ -322,12 +330,9 @@ double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::u
   {
     // The same terms and edges from the free nodes' rows alone: each node's sums in its edges'
     // order, the edges added in theirs (a move of few free nodes skips most edges).
-    for (std::int64_t p = 0; p < n; ++p)
+    for (std::int32_t x = 0; x < active; ++x)
     {
-      if (id[p] < 0)
-      {
-        continue;
-      }
+      const std::int64_t p = freeNodes[x];
       const int a = label[p];
       for (std::int64_t j = around.First[p]; j < around.First[p + 1]; ++j)
       {
@@ -340,16 +345,16 @@ double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::u
         const int b = label[q];
         if (id[q] < 0)
         {
-          keep[p] += a != b ? w : 0.0;
-          take[p] += alpha != b ? w : 0.0;
+          keep[x] += a != b ? w : 0.0;
+          take[x] += alpha != b ? w : 0.0;
         }
         else if ((around.Side[j] & 1) == 0)
         {
-          g.add_edge(id[p], id[q], w, a == b ? w : 0.0);
+          g.add_edge(x, id[q], w, a == b ? w : 0.0);
         }
         else if (a != b)
         {
-          keep[p] += w;
+          keep[x] += w;
         }
       }
     }
@@ -366,7 +371,7 @@ double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::u
       if (id[p] < 0 || id[q] < 0)
       {
         // One end fixed at its label f: the other pays w when its choice differs from f.
-        const std::int64_t x = id[p] < 0 ? q : p;
+        const std::int32_t x = id[p] < 0 ? id[q] : id[p];
         const int f = id[p] < 0 ? a : b;
         const int own = id[p] < 0 ? b : a;
         keep[x] += own != f ? w : 0.0;
@@ -379,25 +384,22 @@ double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::u
       else
       {
         // Keep/keep pays w (a != b), keep/alpha w, alpha/keep w, alpha/alpha 0.
-        keep[q] += w;
+        keep[id[q]] += w;
         g.add_edge(id[p], id[q], w, 0.0);
       }
     });
   }
-  for (std::int64_t p = 0; p < n; ++p)
+  for (std::int32_t x = 0; x < active; ++x)
   {
-    if (id[p] >= 0)
-    {
-      const double low = std::min(keep[p], take[p]);
-      g.add_tweights(id[p], take[p] - low, keep[p] - low);
-    }
+    const double low = std::min(keep[x], take[x]);
+    g.add_tweights(x, take[x] - low, keep[x] - low);
   }
   g.maxflow();
-  for (std::int64_t p = 0; p < n; ++p)
+  for (std::int32_t x = 0; x < active; ++x)
   {
-    if (id[p] >= 0 && g.what_segment(id[p]) == Flow::SINK)
+    if (g.what_segment(x) == Flow::SINK)
     {
-      switched.push_back(p);
+      switched.push_back(freeNodes[x]);
     }
   }
   return MoveChange(pr, alpha, label, around, switched,
