@@ -49,7 +49,11 @@ def run_case(case, methods, draws, generator, cut):
     truth = case.truth().reshape(shape).astype(bool)
     files = file_seeds(case, image)
     rng = np.random.default_rng([generator, zlib.crc32(case.name.encode())])
-    seed_sets = [files] + [metrics.draw_seeds(truth, len(files[0]), len(files[1]), rng) for _ in range(draws)]
+    try:
+        seed_sets = [files] + [metrics.draw_seeds(truth, len(files[0]), len(files[1]), rng) for _ in range(draws)]
+    except ValueError as e:
+        print("%s: no new draws (%s); the seed files only" % (case.name, e))
+        seed_sets = [files]
     rows = []
     for method in methods:
         loop = Loop(method, case, image, cut if method == "supervoxel" else None)
@@ -76,7 +80,11 @@ def run_multilabel_case(case, methods, draws, generator, cut, tmp):
         files.setdefault(label, []).append((ii, jj, kk))
     counts = {label: len(v) for label, v in files.items()}
     rng = np.random.default_rng([generator, zlib.crc32(case.name.encode())])
-    seed_sets = [files] + [metrics.draw_labelled_seeds(truth, counts, rng) for _ in range(draws)]
+    try:
+        seed_sets = [files] + [metrics.draw_labelled_seeds(truth, counts, rng) for _ in range(draws)]
+    except ValueError as e:
+        print("%s: no new draws (%s); the seed files only" % (case.name, e))
+        seed_sets = [files]
     values = fm.v2n(image.GetPointData().GetArray(case.array)).reshape(-1, case.channels)
     unit = ml.unit_channels(values, shape, case.channels) if {"random_walker", "watershed"} & set(methods) else None
     mesh = case.mesh() if "supervoxel" in methods else None
