@@ -68,8 +68,8 @@ struct SuperVoxelCutParameters : SeededCutParameters
   bool VoxelRegionTerm = true;
   // The histograms' samples: the voxels of the elements that hold seeds (true), or those within
   // SeedRadius of each seed voxel, as the voxel cut (false, default: on seeds drawn anew the seed
-  // elements' large, mixed elements made the worse model, docs/cut.md). The local contrast always
-  // takes the latter, and so do labelled seeds of several objects or channels.
+  // elements made the worse model, their unequal sizes weighing some seeds over others, docs/cut.md).
+  // The local contrast always takes the latter, and so do labelled seeds of several objects or channels.
   bool SampleSeedElements = false;
   // With SampleSeedElements: only the seed elements' voxels within this distance (voxels) of a seed
   // of their kind; 0 every voxel of theirs. The Delaunay mesh's long seed elements reach past the
