@@ -85,6 +85,16 @@ class Loop:
             ps.Delete(self.proxy)
 
 
+def file_seeds(case, image):
+    """(object, background) seed lists of the case's seed files, as (i, j, k) voxel indices."""
+    origin, spacing = np.array(image.GetOrigin()), np.array(image.GetSpacing())
+    seeds = []
+    for name in ("seeds_object.csv", "seeds_background.csv"):
+        pts = np.loadtxt(os.path.join(case.folder, name), delimiter=",", skiprows=1, ndmin=2)
+        seeds.append([tuple(int(v) for v in s) for s in np.rint((pts - origin) / spacing)])
+    return seeds
+
+
 def noc(dices, target, rounds):
     hit = [r for r, d in enumerate(dices) if d >= target]
     return hit[0] if hit else rounds + 1
@@ -93,12 +103,8 @@ def noc(dices, target, rounds):
 def run(case, method, rounds, cut=None):
     image = fm.fetch(case.image)
     truth = case.truth().reshape(image.GetDimensions()[::-1]).astype(bool)
-    origin, spacing = np.array(image.GetOrigin()), np.array(image.GetSpacing())
-    seeds = []
-    for name in ("seeds_object.csv", "seeds_background.csv"):
-        pts = np.loadtxt(os.path.join(case.folder, name), delimiter=",", skiprows=1, ndmin=2)
-        seeds.append([tuple(int(v) for v in s) for s in np.rint((pts - origin) / spacing)])
-    object_seeds, background_seeds = seeds
+    spacing = np.array(image.GetSpacing())
+    object_seeds, background_seeds = file_seeds(case, image)
     loop = Loop(method, case, image, cut)
     dices, seconds, lost, added = [], [], 0, []
     for r in range(rounds + 1):

@@ -30,17 +30,8 @@ import numpy as np
 
 import featuremesh as fm
 from featuremesh import metrics, report
-from benchmark_clicks import METHODS, Loop, parse_methods
+from benchmark_clicks import METHODS, Loop, file_seeds, parse_methods
 import benchmark_multilabel as ml
-
-
-def file_seeds(case, image):
-    origin, spacing = np.array(image.GetOrigin()), np.array(image.GetSpacing())
-    out = []
-    for name in ("seeds_object.csv", "seeds_background.csv"):
-        pts = np.loadtxt(os.path.join(case.folder, name), delimiter=",", skiprows=1, ndmin=2)
-        out.append([tuple(int(v) for v in s) for s in np.rint((pts - origin) / spacing)])
-    return out
 
 
 def run_case(case, methods, draws, generator, cut):
@@ -73,10 +64,8 @@ def run_multilabel_case(case, methods, draws, generator, cut, tmp):
     spacing = np.asarray(image.GetSpacing())
     truth = case.truth().reshape(shape)
     k = int(truth.max())
-    rows_files = case.seed_rows()
     files = {}
-    for x, y, z, label in rows_files:
-        kk, jj, ii, _ = ml.seed_index(image, [(x, y, z, label)])[0]
+    for kk, jj, ii, label in ml.seed_index(image, case.seed_rows()):
         files.setdefault(label, []).append((ii, jj, kk))
     counts = {label: len(v) for label, v in files.items()}
     rng = np.random.default_rng([generator, zlib.crc32(case.name.encode())])
@@ -87,28 +76,25 @@ def run_multilabel_case(case, methods, draws, generator, cut, tmp):
         seed_sets = [files]
     values = fm.v2n(image.GetPointData().GetArray(case.array)).reshape(-1, case.channels)
     unit = ml.unit_channels(values, shape, case.channels) if {"random_walker", "watershed"} & set(methods) else None
-    mesh = case.mesh() if "supervoxel" in methods else None
+    # The cuts are made once and re-cut with each draw's seeds (the super-voxel cut keeps its mesh's data).
+    cuts = {}
+    if "supervoxel" in methods:
+        cuts["supervoxel"] = case.super_voxel_cut(case.mesh(), **cut)
+    if "voxel" in methods:
+        cuts["voxel"] = case.voxel_cut()
     rows = []
     for d, seeds in enumerate(seed_sets):
-        world = [image.GetPoint(image.ComputePointId([i, j, kk])) + (label,)
-                 for label in sorted(seeds) for i, j, kk in seeds[label]]
-        path = os.path.join(tmp, "%s-%d.csv" % (case.name, d))
-        ml.write_seeds(path, world)
         index = [(kk, j, i, label) for label in sorted(seeds) for i, j, kk in seeds[label]]
+        path = os.path.join(tmp, "%s-%d.csv" % (case.name, d))
+        ml.write_seeds(path, [image.GetPoint(image.ComputePointId([i, j, kk])) + (label,) for kk, j, i, label in index])
+        reader = ps.CSVReader(FileName=[path])
         for method in methods:
-            if method in ("supervoxel", "voxel"):
-                reader = ps.CSVReader(FileName=[path])
-                names = ";".join(case.names)
-                scalars = ["POINTS", case.array]
-                proxy = ps.SuperVoxelCut(Mesh=mesh, Seeds=reader, Image=case.image, Scalars=scalars, LabelNames=names,
-                                         **cut) if method == "supervoxel" else \
-                    ps.VoxelCut(Input=case.image, Seeds=reader, Scalars=scalars, LabelNames=names)
+            if method in cuts:
+                cuts[method].Seeds = reader
                 t = time.perf_counter()
-                proxy.UpdatePipeline()
+                cuts[method].UpdatePipeline()
                 seconds = time.perf_counter() - t
-                result = fm.labels(proxy, 2 if method == "supervoxel" else 0)
-                ps.Delete(proxy)
-                ps.Delete(reader)
+                result = fm.labels(cuts[method], 2 if method == "supervoxel" else 0)
             elif method == "random_walker":
                 result, seconds = ml.random_walker(unit, ml.markers(shape, index), spacing)
             else:
@@ -118,6 +104,8 @@ def run_multilabel_case(case, methods, draws, generator, cut, tmp):
                          "dice": float(np.mean(per_label)), "smallest": float(min(per_label)), "seconds": seconds})
             print("%s draw %d %s: mean Dice %.3f, smallest label %.3f (%.2f s)" % (
                 case.name, d, method, rows[-1]["dice"], rows[-1]["smallest"], seconds), flush=True)
+    for p in ps.GetSources().values():
+        ps.Delete(p)
     return rows
 
 
