@@ -85,7 +85,9 @@ def main():
                "empty_after_pct": 100.0 * (v2n(m1.GetCellData().GetArray(fm.names.PixelCount)) == 0).mean(),
                "smoothing_s": statistics.median(seconds),
                "sweeps_s": fd.GetArray(fm.names.SweepSeconds).GetValue(0),
-               "refinement_s": fd.GetArray(fm.names.RefinementSeconds).GetValue(0)}
+               "refinement_s": fd.GetArray(fm.names.RefinementSeconds).GetValue(0),
+               "slivers_s": fd.GetArray(fm.names.SliverSeconds).GetValue(0),
+               "statistics_s": fd.GetArray(fm.names.StatisticsSeconds).GetValue(0)}
         rows.append(row)
         print(" | ".join("%s %s" % (k, ("%.3f" % v) if isinstance(v, float) else v) for k, v in row.items()), flush=True)
     keys = list(rows[0].keys()) if rows else []
