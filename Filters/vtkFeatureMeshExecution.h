@@ -59,6 +59,8 @@ void SetClampedParameter(vtkObject* filter, Parameter& parameter, int value, int
   double cls::GetGeodesicWeight() { return this->Geodesic.Weight; }                                                \
   void cls::SetGeodesicLength(double value) { featuremesh::SetParameter(this, this->Geodesic.LengthWeight, value); } \
   double cls::GetGeodesicLength() { return this->Geodesic.LengthWeight; }                                          \
+  void cls::SetAdaptiveGeodesicWeight(bool value) { featuremesh::SetParameter(this, this->Geodesic.Adaptive, value); } \
+  bool cls::GetAdaptiveGeodesicWeight() { return this->Geodesic.Adaptive; }                                        \
   void cls::SetChannelModel(int value) { featuremesh::SetClampedParameter(this, this->Channels, value, 0, 2); }    \
   int cls::GetChannelModel() { return static_cast<int>(this->Channels); }
 

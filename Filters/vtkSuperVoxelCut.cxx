@@ -251,7 +251,8 @@ void vtkSuperVoxelCut::WriteCutFields(
   const auto objectElements = std::count(cut.Label.begin(), cut.Label.end(), LabelObject);
   for (vtkDataObject* d : { vtkDataObject::GetData(outputVector, 0), vtkDataObject::GetData(outputVector, 2) })
   {
-    AddFieldValues(d, { { names::Sigma, cut.Sigma }, { names::Bins, cut.Bins }, { names::Flow, cut.Flow },
+    AddFieldValues(d, { { names::Sigma, cut.Sigma }, { names::Bins, cut.Bins }, { names::SeedOverlap, cut.SeedOverlap },
+                        { names::SpatialWeight, cut.SpatialWeight }, { names::Flow, cut.Flow },
                         { names::ObjectElements, static_cast<double>(objectElements) } });
     AddObjectComponents(d, cut.ObjectComponentVoxels, voxelVolume, cut.ConnectivityChanged);
     AddFieldValues(d, { { names::SetupSeconds, result.SetupSeconds },
@@ -406,8 +407,8 @@ featuremesh::VoxelRefinementResult vtkSuperVoxelCut::RefineBinary(featuremesh::S
   VoxelRefinementResult refinement = this->Refine(cut.Label, 2, values, seedVoxels,
     [&](std::int64_t v, std::int64_t e, double* costs) {
       const int b = cut.ValueBin(value(v));
-      costs[0] = lambda * (cut.BinCostBackground[b] + (spatial ? cut.SpatialBackground[e] : 0.0));
-      costs[1] = lambda * (cut.BinCostObject[b] + (spatial ? cut.SpatialObject[e] : 0.0));
+      costs[0] = lambda * (cut.BinCostBackground[b] + (spatial ? cut.SpatialScale * cut.SpatialBackground[e] : 0.0));
+      costs[1] = lambda * (cut.BinCostObject[b] + (spatial ? cut.SpatialScale * cut.SpatialObject[e] : 0.0));
     },
     &result.ObjectComponent, 0.9);
   // The components' volumes hold the refined voxels too.
@@ -676,6 +677,7 @@ void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
      << indent << "ContrastScale: " << this->ContrastScale << "\n"
      << indent << "GeodesicWeight: " << this->GetGeodesicWeight() << "\n"
      << indent << "GeodesicLength: " << this->GetGeodesicLength() << "\n"
+     << indent << "AdaptiveGeodesicWeight: " << this->GetAdaptiveGeodesicWeight() << "\n"
      << indent << "Bandwidth: " << this->Bandwidth << "\n"
      << indent << "SuperVoxelIds: " << this->SuperVoxelIds << "\n"
      << indent << "ScaleByContact: " << this->ScaleByContact << "\n"

@@ -85,6 +85,11 @@ public:
   /// Length of a voxel of travel in the geodesic, in units of the intensity range.
   virtual void SetGeodesicLength(double value);
   virtual double GetGeodesicLength();
+  /// With one object: scale the geodesic weight by the overlap of the seeds' intensity densities over
+  /// featuremesh::SeedOverlapReference (default on; SeedGeodesicParameters::Adaptive).
+  virtual void SetAdaptiveGeodesicWeight(bool value);
+  virtual bool GetAdaptiveGeodesicWeight();
+  vtkBooleanMacro(AdaptiveGeodesicWeight, bool);
   /// Kernel bandwidth of the seed histograms as a multiple of Silverman's rule (default 1).
   vtkSetMacro(Bandwidth, double);
   vtkGetMacro(Bandwidth, double);

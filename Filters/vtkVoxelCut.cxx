@@ -122,7 +122,8 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
       return cut.Aborted ? 1 : this->Fail(cut.Error);
     }
     SetLabelImage(output, geometry, cut.Label);
-    AddFieldValues(output, { { names::Sigma, cut.Sigma }, { names::Bins, cut.Bins }, { names::Flow, cut.Flow },
+    AddFieldValues(output, { { names::Sigma, cut.Sigma }, { names::Bins, cut.Bins }, { names::SeedOverlap, cut.SeedOverlap },
+                             { names::SpatialWeight, cut.SpatialWeight }, { names::Flow, cut.Flow },
                              { names::GraphSeconds, cut.GraphSeconds }, { names::FlowSeconds, cut.FlowSeconds },
                              { names::GeodesicSeconds, cut.GeodesicSeconds } });
     AddObjectComponents(output, cut.ObjectComponentVoxels, geometry.VoxelVolume(), cut.ConnectivityChanged);
@@ -189,6 +190,7 @@ void vtkVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
      << indent << "ContrastScale: " << this->ContrastScale << "\n"
      << indent << "GeodesicWeight: " << this->GetGeodesicWeight() << "\n"
      << indent << "GeodesicLength: " << this->GetGeodesicLength() << "\n"
+     << indent << "AdaptiveGeodesicWeight: " << this->GetAdaptiveGeodesicWeight() << "\n"
      << indent << "Bandwidth: " << this->Bandwidth << "\n"
      << indent << "SeedRadius: " << this->SeedRadius << "\n"
      << indent << "SeedLabelArray: " << this->SeedLabelArray << "\n"

@@ -120,6 +120,8 @@ constexpr const char* VolumeSeconds = "VolumeSeconds";
 // Stage 4.
 constexpr const char* Sigma = "Sigma";
 constexpr const char* Bins = "Bins";
+constexpr const char* SeedOverlap = "SeedOverlap";     // the seeds' densities' Bhattacharyya coefficient (binary cut)
+constexpr const char* SpatialWeight = "SpatialWeight"; // the geodesic weight a binary cut used (0: none)
 constexpr const char* Flow = "Flow";
 constexpr const char* ObjectElements = "ObjectElements";
 constexpr const char* ObjectComponents = "ObjectComponents";

@@ -69,6 +69,45 @@ TEST(BoykovJolly, SeparatesTwoPlateausAndHonoursSeeds)
   EXPECT_FALSE(ValidateParameters(bad).empty());
 }
 
+TEST(BoykovJolly, TheGeodesicWeightFollowsTheSeedDensitiesOverlap)
+{
+  // A noisy ramp: the spatial term decides where the region term is unsure.
+  std::vector<double> values;
+  for (int i = 0; i < 40; ++i)
+    values.push_back(10.0 - 0.25 * i + ((i * 7) % 5) * 0.3);
+  auto cut = [&](std::vector<double> object, std::vector<double> background, bool adaptive, double weight) {
+    CutProblem pr = SeededChain(values);
+    pr.ObjectSamples = std::move(object);
+    pr.BackgroundSamples = std::move(background);
+    pr.Geodesic.Weight = weight;
+    pr.Geodesic.Adaptive = adaptive;
+    const CutResult r = BoykovJollyCut(pr, BoykovJollyParameters());
+    EXPECT_TRUE(r.Error.empty()) << r.Error;
+    return r;
+  };
+  const double w = SeedGeodesicParameters().Weight;
+  // The same samples: the densities are one, the weight the most it gets.
+  const CutResult same = cut({ 4.0, 5.0, 6.0, 5.5 }, { 4.0, 5.0, 6.0, 5.5 }, true, w);
+  EXPECT_NEAR(same.SeedOverlap, 1.0, 1e-9);
+  EXPECT_NEAR(same.SpatialWeight, w / SeedOverlapReference, 1e-9);
+  // Apart: appearance decides, the spatial term weighs little.
+  const CutResult apart = cut({ 10.0, 9.5, 9.8 }, { 0.0, 0.4, 0.2 }, true, w);
+  EXPECT_LT(apart.SeedOverlap, 0.2);
+  EXPECT_NEAR(apart.SpatialWeight, w * apart.SeedOverlap / SeedOverlapReference, 1e-12);
+  // Overlapping: the adaptive cut is the fixed cut at the weight it reports.
+  const std::vector<double> object = { 10.0, 8.0, 6.5, 7.0 }, background = { 7.5, 3.0, 1.0, 0.5 };
+  const CutResult adaptive = cut(object, background, true, w);
+  EXPECT_GT(adaptive.SeedOverlap, 0.2);
+  EXPECT_LT(adaptive.SeedOverlap, 0.9);
+  const CutResult fixed = cut(object, background, false, adaptive.SpatialWeight);
+  EXPECT_EQ(fixed.SpatialWeight, adaptive.SpatialWeight);
+  EXPECT_EQ(fixed.Label, adaptive.Label);
+  EXPECT_NEAR(fixed.Flow, adaptive.Flow, 1e-9 * fixed.Flow);
+  // Off, or without the term: the weight as given, or none.
+  EXPECT_EQ(cut(object, background, false, w).SpatialWeight, w);
+  EXPECT_EQ(cut(object, background, true, 0.0).SpatialWeight, 0.0);
+}
+
 TEST(BoykovJolly, AutomaticBinsResolveNarrowDensitiesInAWideRange)
 {
   // A CT in miniature: object tissue near 52, background tissue near 44 and air near -1000. With 64

@@ -137,6 +137,19 @@ for step, change in (("a seed edit", lambda: setattr(edited, "Points", points[3:
 # graph), seeds placed where the result is wrong (the band moves and the domain grows) and a seed
 # moved by a voxel and back (the band stays inside it) give what a fresh filter gives.
 d, image, truth, so, sb, cut = run("liver-ct-totalseg")
+# The geodesic weight the cut used: Geodesic Weight times the seed densities' overlap over 0.75
+# (Adaptive Geodesic Weight, on), or Geodesic Weight as it is (off), which cuts the liver otherwise.
+fields = ft.fetch(cut, 2).GetFieldData()
+overlap, used = (fields.GetArray(n).GetValue(0) for n in (ft.names.SeedOverlap, ft.names.SpatialWeight))
+weight = float(cut.GeodesicWeight)
+ft.check(0.0 < overlap < 1.0 and abs(used - weight * overlap / 0.75) <= 1e-9 * weight,
+         "liver: adaptive geodesic weight %.3f = %.2f x overlap %.3f / 0.75" % (used, weight, overlap))
+fixed = ft.SuperVoxelCut(Mesh=cut.Mesh, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, AdaptiveGeodesicWeight=0)
+fixed.UpdatePipeline()
+fixed_used = ft.fetch(fixed, 2).GetFieldData().GetArray(ft.names.SpatialWeight).GetValue(0)
+ft.check(fixed_used == weight and not ft.np.array_equal(ft.fm.labels(fixed), ft.fm.labels(cut)),
+         "liver: the fixed weight %.3f cuts otherwise" % fixed_used)
+ft.Delete(fixed)
 vtk_image = ft.fetch(image)
 shape, spacing = vtk_image.GetDimensions()[::-1], vtk_image.GetSpacing()
 truth = ft.array(ft.fetch(truth)).reshape(shape) != 0

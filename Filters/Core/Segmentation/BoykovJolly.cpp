@@ -771,13 +771,18 @@ struct BinCosts
 {
   std::vector<double> Object, Background;
 };
-BinCosts LabelBinCosts(const CutProblem& pr, const HistogramLattice& lattice, double bandwidth)
+BinCosts LabelBinCosts(const CutProblem& pr, const HistogramLattice& lattice, double bandwidth, double& overlap)
 {
   const double low = lattice.HistogramLow(), high = lattice.HistogramHigh();
   const std::vector<double> pObject = SmoothedHistogram(pr.ObjectSamples, pr.ObjectWeights, low, high, lattice.Bins, bandwidth);
   const std::vector<double> pBackground =
     SmoothedHistogram(pr.BackgroundSamples, pr.BackgroundWeights, low, high, lattice.Bins, bandwidth);
   BinCosts costs{ std::vector<double>(lattice.Size), std::vector<double>(lattice.Size) };
+  overlap = 0.0;
+  for (int b = 0; b < lattice.Bins; ++b)
+  {
+    overlap += std::sqrt(pObject[b] * pBackground[b]);
+  }
   for (int j = 0; j < lattice.Size; ++j)
   {
     const int b = std::min(lattice.Bins - 1, std::max(0, j - lattice.First));
@@ -1047,12 +1052,12 @@ std::shared_ptr<MaxFlowCache::Kept> NewKept(const CutProblem& pr, double sigmaPa
   kept->WeightTotal = weightTotal;
   return kept;
 }
-// Step 5b: the spatial term (per voxel, when there is one) added to both region costs, lambda
+// Step 5b: the spatial term (per voxel, when there is one) times spatialScale added to both region costs, lambda
 // times their sums, and K's share of them (the larger per node) added to `total`, in one pass.
 // False when progress asked to abort.
 bool ScaleRegionCosts(const CutProblem& pr, const SharedArray<double>& spatialObject,
   const SharedArray<double>& spatialBackground, double lambda, std::int64_t n, double* regionObject,
-  double* regionBackground, double& total, const ProgressFunction& progress)
+  double* regionBackground, double& total, const ProgressFunction& progress, double spatialScale)
 {
   const bool spatial = !spatialObject.empty();
   for (std::int64_t p = 0; p < n; ++p)
@@ -1060,8 +1065,8 @@ bool ScaleRegionCosts(const CutProblem& pr, const SharedArray<double>& spatialOb
     if (spatial)
     {
       const double size = pr.Size.empty() ? 1.0 : pr.Size[p];
-      regionObject[p] += size * spatialObject[p];
-      regionBackground[p] += size * spatialBackground[p];
+      regionObject[p] += spatialScale * size * spatialObject[p];
+      regionBackground[p] += spatialScale * size * spatialBackground[p];
     }
     regionObject[p] *= lambda;
     regionBackground[p] *= lambda;
@@ -1100,7 +1105,12 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   // 1-2. The histogram and each label's cost per bin.
   const HistogramLattice lattice = MakeHistogramLattice(pr, par);
   r.Bins = lattice.Bins;
-  const BinCosts costs = LabelBinCosts(pr, lattice, par.Bandwidth);
+  const BinCosts costs = LabelBinCosts(pr, lattice, par.Bandwidth, r.SeedOverlap);
+  // The spatial term's costs are kept at Geodesic.Weight; the adaptive weight scales them as they join.
+  if (pr.Geodesic.Adaptive)
+  {
+    r.SpatialScale = r.SeedOverlap / SeedOverlapReference;
+  }
   const double low = lattice.Low, width = lattice.Width;
   const HistogramBins bin(lattice.Size, low, width);
 
@@ -1137,11 +1147,12 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
     aborted(SeedGeodesicTerm(pr, lattice.HistogramHigh() - lattice.HistogramLow(), cache ? &cache->Geodesic : nullptr,
       spatialObject, spatialBackground, SubProgress(progress, 0.3, 0.33), r.GeodesicSeconds)) ||
     aborted(ScaleRegionCosts(pr, spatialObject, spatialBackground, par.Lambda, n, regionObject.get(), regionBackground.get(),
-      total, SubProgress(progress, 0.33, 0.35))) ||
+      total, SubProgress(progress, 0.33, 0.35), r.SpatialScale)) ||
     aborted(progress(0.35)))
   {
     return r;
   }
+  r.SpatialWeight = spatialObject.empty() ? 0.0 : pr.Geodesic.Weight * r.SpatialScale;
   // K exceeds the energy of any labelling, so hard constraints are never cut.
   const double K = total;
   if (!std::isfinite(K))

@@ -146,6 +146,9 @@ struct CutResult
   ValueBins ValueBin;
   std::vector<double> BinCostObject, BinCostBackground;
   SharedArray<double> SpatialObject, SpatialBackground;
+  // The seed densities' overlap (Bhattacharyya coefficient) and the spatial term's weight this cut
+  // used; SpatialObject / SpatialBackground are at Geodesic.Weight, and SpatialScale takes them to it.
+  double SeedOverlap = 0.0, SpatialWeight = 0.0, SpatialScale = 1.0;
   std::string Error;
   bool Aborted = false;
 };

@@ -28,7 +28,17 @@ struct SeedGeodesicParameters
   // Length of one voxel of travel, in units of the intensity range: a path through a homogeneous
   // region costs about this per voxel, so seeds reach far across flat regions and stop at edges.
   double LengthWeight = 0.005;
+  // The binary cut's Weight follows the seeds' intensity densities: it holds where the object's and
+  // the background's densities overlap by SeedOverlapReference (Bhattacharyya coefficient, 0
+  // disjoint to 1 the same) and scales with their overlap, so appearance that tells the seeds apart
+  // decides and ambiguous appearance leaves more to the seeds' geometry (after Price, Morse & Cohen's
+  // adaptive weighting; docs/cut.md). The multi-label cut keeps Weight: its joint densities of
+  // several channels overlap on another scale.
+  bool Adaptive = true;
 };
+
+// The overlap at which an adaptive Weight holds: BraTS-0005's seed files, the case Weight was chosen on.
+constexpr double SeedOverlapReference = 0.75;
 
 // The graph the distances run on: node values and edges; for explicit edges the length of each in
 // voxels (Step, centre to centre); the grid's edges are one voxel long. A cache shares the arrays.
