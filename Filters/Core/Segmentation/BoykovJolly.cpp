@@ -1052,8 +1052,9 @@ std::shared_ptr<MaxFlowCache::Kept> NewKept(const CutProblem& pr, double sigmaPa
   kept->WeightTotal = weightTotal;
   return kept;
 }
-// Step 5b: the spatial term (per voxel, when there is one) times spatialScale added to both region costs, lambda
-// times their sums, and K's share of them (the larger per node) added to `total`, in one pass.
+// Step 5b: the spatial term (per voxel, when there is one) times spatialScale added to both region
+// costs, lambda times their sums, and K's share of them (the larger per node) added to `total`, in
+// one pass.
 // False when progress asked to abort.
 bool ScaleRegionCosts(const CutProblem& pr, const SharedArray<double>& spatialObject,
   const SharedArray<double>& spatialBackground, double lambda, std::int64_t n, double* regionObject,

@@ -108,7 +108,8 @@ struct CutProblem
   // over its voxel values x of -ln Pr(x | L) instead of Size_p * -ln Pr(Value_p | L). A mixed
   // element then costs what its voxels would cost in the voxel cut, rather than what its mean would.
   const NodeVoxelValues* NodeVoxels = nullptr;
-  // The seeds' spatial term (SeedGeodesics.h), per voxel of each node; Weight 0 = off. Step: the
+  // The seeds' spatial term (SeedGeodesics.h), per voxel of each node, its Weight scaled by the seed
+  // densities' overlap when Adaptive; Weight 0 = off. Step: the
   // length of each explicit edge in voxels (empty: 1 each, the voxel grid).
   SeedGeodesicParameters Geodesic{ 0.0 };
   SharedArray<double> Step;
