@@ -1,6 +1,6 @@
 """Other seeds on the same cases (pvpython): how the defaults hold on seeds they were not chosen on.
 
-usage: pvpython scripts/benchmark_seeds.py [--draws 5] [--cases a,b] [--multilabel] [--generator 0]
+usage: pvpython scripts/benchmark_seeds.py [--draws 5] [--cases a,b] [--multilabel | --held-out] [--generator 0]
                                            [--methods supervoxel,voxel,random_walker,watershed]
                                            [--cut SeedElementRadius=0] [--out out/benchmark_seeds]
 The shared seed files are one draw of a fixed generator (the shared data's README: object seeds at
@@ -14,6 +14,11 @@ re-cuts one mesh per case (stages 1 -> 2 -> 3 do not read the seeds); the other 
 eroded by 2 voxels, 20 background seeds from the band 3-15 voxels around the labels' union; as many
 per label as seeds.csv holds), the methods of benchmark_multilabel.py, and scores each draw by the
 mean of its labels' Dice (the smallest label's in the CSV).
+--held-out runs object cases that no default was chosen on, made from the multi-label cases'
+references (held_out_cases): each abdomen organ but the liver (the liver case's own image), and
+BraTS's tumour core (core + enhancing) and enhancing tumour on T1c, the regions BraTS scores
+beside the whole tumour (the binary cases' object, on FLAIR). Each gets the binary cases' 10 object
+and 20 background seeds from the generator rule, and Task Object.
 
 Per case and method: Dice on the files, the mean, smallest and largest over the new draws, and on
 how many draws the super-voxel cut is at least the method's Dice (at least the voxel cut's - 0.01
@@ -28,10 +33,76 @@ import zlib
 
 import numpy as np
 
+from vtkmodules.util.numpy_support import numpy_to_vtk
+from vtkmodules.vtkCommonDataModel import vtkImageData
+
 import featuremesh as fm
 from featuremesh import metrics, report
 from benchmark_clicks import METHODS, Loop, file_seeds, parse_methods
 import benchmark_multilabel as ml
+
+
+# (multi-label case, name, its labels that form the object, image channel) of each held-out object case.
+HELD_OUT = [("abdomen-ct-totalseg", "abdomen-spleen", (2,), 0),
+            ("abdomen-ct-totalseg", "abdomen-kidney-right", (3,), 0),
+            ("abdomen-ct-totalseg", "abdomen-kidney-left", (4,), 0),
+            ("abdomen-ct-totalseg", "abdomen-stomach", (5,), 0),
+            ("brain-tumour-regions-brats-0005", "brats-0005-tumour-core-t1c", (2, 3), 1),
+            ("brain-tumour-regions-brats-0005", "brats-0005-enhancing-t1c", (3,), 1),
+            ("brain-tumour-regions-brats-0006", "brats-0006-tumour-core-t1c", (2, 3), 1),
+            ("brain-tumour-regions-brats-0006", "brats-0006-enhancing-t1c", (3,), 1)]
+
+
+def held_out_cases(root, selection, generator):
+    """{name: folder} of the held-out object cases (HELD_OUT), written under `root` as binary case
+    folders: one channel's image.mha, truth.mha and seed files drawn by the generator rule."""
+    from vtkmodules.vtkIOImage import vtkMetaImageWriter
+    from vtkmodules.vtkImagingCore import vtkImageExtractComponents
+    from vtkmodules.vtkIOImage import vtkMetaImageReader
+    wanted = [c for c in selection.split(",") if c]
+    found = fm.multilabel_cases()
+    out = {}
+    for source, name, labels, channel in HELD_OUT:
+        if source not in found or (wanted and name not in wanted):
+            continue
+        folder = os.path.join(root, name)
+        os.makedirs(folder, exist_ok=True)
+        reader = vtkMetaImageReader()
+        reader.SetFileName(os.path.join(found[source], "image.mha"))
+        extract = vtkImageExtractComponents()
+        extract.SetInputConnection(reader.GetOutputPort())
+        extract.SetComponents(channel)
+        extract.Update()
+        image = extract.GetOutput()
+        image.GetPointData().GetScalars().SetName("Channel%d" % channel)
+        truth_reader = vtkMetaImageReader()
+        truth_reader.SetFileName(os.path.join(found[source], "truth.mha"))
+        truth_reader.Update()
+        truth_image = truth_reader.GetOutput()
+        labels_array = fm.v2n(truth_image.GetPointData().GetScalars())
+        truth = np.isin(labels_array, labels).astype(np.uint8)
+        mask = vtkImageData()
+        mask.ShallowCopy(truth_image)
+        mask.GetPointData().SetScalars(numpy_to_vtk(truth, deep=True))
+        for data, file in ((image, "image.mha"), (mask, "truth.mha")):
+            writer = vtkMetaImageWriter()
+            writer.SetFileName(os.path.join(folder, file))
+            writer.SetCompression(True)
+            writer.SetInputData(data)
+            writer.Write()
+        rng = np.random.default_rng([generator, zlib.crc32(("files " + name).encode())])
+        shape = image.GetDimensions()[::-1]
+        obj, bg = metrics.draw_seeds(truth.reshape(shape).astype(bool), HELD_OUT_SEEDS[0], HELD_OUT_SEEDS[1], rng)
+        origin, spacing = np.array(image.GetOrigin()), np.array(image.GetSpacing())
+        for seeds, file in ((obj, "seeds_object.csv"), (bg, "seeds_background.csv")):
+            np.savetxt(os.path.join(folder, file), origin + np.asarray(seeds, float) * spacing, delimiter=",",
+                       header="x,y,z", comments="", fmt="%.6g")
+        out[name] = folder
+    return out
+
+
+# The binary 3D cases' seed files: 10 object seeds, 20 background seeds.
+HELD_OUT_SEEDS = (10, 20)
 
 
 def run_case(case, methods, draws, generator, cut):
@@ -150,6 +221,8 @@ def main():
     ap.add_argument("--generator", type=int, default=0)
     ap.add_argument("--cases", default="")
     ap.add_argument("--multilabel", action="store_true", help="the multi-label cases instead of the binary ones")
+    ap.add_argument("--held-out", action="store_true",
+                    help="object cases made from the multi-label references, on which no default was chosen")
     ap.add_argument("--methods", default=",".join(METHODS))
     ap.add_argument("--cut", default="", type=fm.parse_properties,
                     help="properties of the Super-Voxel Cut, e.g. SeedElementRadius=0")
@@ -163,8 +236,16 @@ def main():
         print("shared data not found at %s: only the bundled cases run" % fm.SHARED)
     rows = []
     tmp = tempfile.mkdtemp()
-    for name, folder in (fm.multilabel_cases(args.cases) if args.multilabel else fm.cases(args.cases)).items():
+    if args.multilabel and args.held_out:
+        raise SystemExit("--multilabel and --held-out exclude each other")
+    if args.held_out:
+        folders = held_out_cases(os.path.join(tmp, "held-out"), args.cases, args.generator)
+    else:
+        folders = fm.multilabel_cases(args.cases) if args.multilabel else fm.cases(args.cases)
+    for name, folder in folders.items():
         case = fm.MultiLabelCase(folder) if args.multilabel else fm.Case(folder)
+        if args.held_out:
+            case.task = "object"
         if case.truth() is None:
             print("%s: no truth.mha, skipped" % name)
             continue
