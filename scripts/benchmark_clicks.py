@@ -3,7 +3,7 @@ wrong, as in the standard protocol of interactive segmentation (NoC@85 / NoC@90:
 interactive object selection", CVPR 2016).
 
 usage: pvpython scripts/benchmark_clicks.py [--rounds 10] [--cases a,b] [--methods supervoxel,voxel,random_walker,watershed]
-                                            [--cut VoxelRefinement=0] [--out out/benchmark_clicks]
+                                            [--cut VoxelRefinement=0] [--held-out] [--out out/benchmark_clicks]
 Each case starts from its seed files and runs with its task (cases.csv). Each round: the largest
 connected error region of the current result (face-connected; false positives and false negatives
 apart), one seed at its most interior voxel (largest distance to the region's border, in world
@@ -11,7 +11,9 @@ units; the first in raster order on ties): a background seed in a false positive
 a false negative; then the method segments again. Up to --rounds rounds (fewer when nothing is
 wrong). Methods: the super-voxel cut re-cutting its kept mesh (stages 1 -> 2 -> 3 made once, as in
 the GUI; only the cut re-runs), the voxel cut, scikit-image's random walker and the seeded watershed
-on the gradient (featuremesh.metrics), each re-run from all seeds every round.
+on the gradient (featuremesh.metrics), each re-run from all seeds every round. --held-out runs the
+held-out object cases instead (featuremesh.held_out: made from the multi-label references, on which no
+default was chosen).
 
 Per method and case: Dice after each round (round 0 = the seed files), NoC@85 and NoC@90 (rounds
 to reach the Dice; 0 when the seed files do, rounds + 1 when never), the median seconds of a round,
@@ -22,13 +24,14 @@ import argparse
 import csv
 import os
 import statistics
+import tempfile
 import time
 
 import numpy as np
 import paraview.simple as ps
 
 import featuremesh as fm
-from featuremesh import metrics, report
+from featuremesh import held_out, metrics, report
 
 METHODS = ("supervoxel", "voxel", "random_walker", "watershed")
 
@@ -137,6 +140,7 @@ def main():
     ap.add_argument("--methods", default=",".join(METHODS))
     ap.add_argument("--cut", default="", type=fm.parse_properties,
                     help="properties of the Super-Voxel Cut, e.g. VoxelRefinement=0")
+    ap.add_argument("--held-out", action="store_true", help="the held-out object cases (featuremesh.held_out)")
     ap.add_argument("--out", default=os.path.join(fm.ROOT, "out", "benchmark_clicks"))
     args = ap.parse_args()
     methods = parse_methods(args.methods)
@@ -144,8 +148,14 @@ def main():
     if not os.path.isdir(os.path.join(fm.SHARED, "cases")):
         print("shared data not found at %s: only the bundled cases run" % fm.SHARED)
     rows = []
-    for name, folder in fm.cases(args.cases).items():
+    if args.held_out:
+        folders = held_out.cases(os.path.join(tempfile.mkdtemp(), "held-out"), args.cases, 0)
+    else:
+        folders = fm.cases(args.cases)
+    for name, folder in folders.items():
         case = fm.Case(folder)
+        if args.held_out:
+            case.task = "object"
         if case.truth() is None:
             print("%s: no truth.mha, skipped" % name)
             continue

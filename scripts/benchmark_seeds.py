@@ -15,7 +15,7 @@ eroded by 2 voxels, 20 background seeds from the band 3-15 voxels around the lab
 per label as seeds.csv holds), the methods of benchmark_multilabel.py, and scores each draw by the
 mean of its labels' Dice (the smallest label's in the CSV).
 --held-out runs object cases that no default was chosen on, made from the multi-label cases'
-references (held_out_cases): each abdomen organ but the liver (the liver case's own image), and
+references (featuremesh.held_out): each abdomen organ but the liver (the liver case's own image), and
 BraTS's tumour core (core + enhancing) and enhancing tumour on T1c, the regions BraTS scores
 beside the whole tumour (the binary cases' object, on FLAIR). Each gets the binary cases' 10 object
 and 20 background seeds from the generator rule, and Task Object.
@@ -33,76 +33,10 @@ import zlib
 
 import numpy as np
 
-from vtkmodules.util.numpy_support import numpy_to_vtk
-from vtkmodules.vtkCommonDataModel import vtkImageData
-
 import featuremesh as fm
-from featuremesh import metrics, report
+from featuremesh import held_out, metrics, report
 from benchmark_clicks import METHODS, Loop, file_seeds, parse_methods
 import benchmark_multilabel as ml
-
-
-# (multi-label case, name, its labels that form the object, image channel) of each held-out object case.
-HELD_OUT = [("abdomen-ct-totalseg", "abdomen-spleen", (2,), 0),
-            ("abdomen-ct-totalseg", "abdomen-kidney-right", (3,), 0),
-            ("abdomen-ct-totalseg", "abdomen-kidney-left", (4,), 0),
-            ("abdomen-ct-totalseg", "abdomen-stomach", (5,), 0),
-            ("brain-tumour-regions-brats-0005", "brats-0005-tumour-core-t1c", (2, 3), 1),
-            ("brain-tumour-regions-brats-0005", "brats-0005-enhancing-t1c", (3,), 1),
-            ("brain-tumour-regions-brats-0006", "brats-0006-tumour-core-t1c", (2, 3), 1),
-            ("brain-tumour-regions-brats-0006", "brats-0006-enhancing-t1c", (3,), 1)]
-
-
-def held_out_cases(root, selection, generator):
-    """{name: folder} of the held-out object cases (HELD_OUT), written under `root` as binary case
-    folders: one channel's image.mha, truth.mha and seed files drawn by the generator rule."""
-    from vtkmodules.vtkIOImage import vtkMetaImageWriter
-    from vtkmodules.vtkImagingCore import vtkImageExtractComponents
-    from vtkmodules.vtkIOImage import vtkMetaImageReader
-    wanted = [c for c in selection.split(",") if c]
-    found = fm.multilabel_cases()
-    out = {}
-    for source, name, labels, channel in HELD_OUT:
-        if source not in found or (wanted and name not in wanted):
-            continue
-        folder = os.path.join(root, name)
-        os.makedirs(folder, exist_ok=True)
-        reader = vtkMetaImageReader()
-        reader.SetFileName(os.path.join(found[source], "image.mha"))
-        extract = vtkImageExtractComponents()
-        extract.SetInputConnection(reader.GetOutputPort())
-        extract.SetComponents(channel)
-        extract.Update()
-        image = extract.GetOutput()
-        image.GetPointData().GetScalars().SetName("Channel%d" % channel)
-        truth_reader = vtkMetaImageReader()
-        truth_reader.SetFileName(os.path.join(found[source], "truth.mha"))
-        truth_reader.Update()
-        truth_image = truth_reader.GetOutput()
-        labels_array = fm.v2n(truth_image.GetPointData().GetScalars())
-        truth = np.isin(labels_array, labels).astype(np.uint8)
-        mask = vtkImageData()
-        mask.ShallowCopy(truth_image)
-        mask.GetPointData().SetScalars(numpy_to_vtk(truth, deep=True))
-        for data, file in ((image, "image.mha"), (mask, "truth.mha")):
-            writer = vtkMetaImageWriter()
-            writer.SetFileName(os.path.join(folder, file))
-            writer.SetCompression(True)
-            writer.SetInputData(data)
-            writer.Write()
-        rng = np.random.default_rng([generator, zlib.crc32(("files " + name).encode())])
-        shape = image.GetDimensions()[::-1]
-        obj, bg = metrics.draw_seeds(truth.reshape(shape).astype(bool), HELD_OUT_SEEDS[0], HELD_OUT_SEEDS[1], rng)
-        origin, spacing = np.array(image.GetOrigin()), np.array(image.GetSpacing())
-        for seeds, file in ((obj, "seeds_object.csv"), (bg, "seeds_background.csv")):
-            np.savetxt(os.path.join(folder, file), origin + np.asarray(seeds, float) * spacing, delimiter=",",
-                       header="x,y,z", comments="", fmt="%.6g")
-        out[name] = folder
-    return out
-
-
-# The binary 3D cases' seed files: 10 object seeds, 20 background seeds.
-HELD_OUT_SEEDS = (10, 20)
 
 
 def run_case(case, methods, draws, generator, cut):
@@ -239,7 +173,7 @@ def main():
     if args.multilabel and args.held_out:
         raise SystemExit("--multilabel and --held-out exclude each other")
     if args.held_out:
-        folders = held_out_cases(os.path.join(tmp, "held-out"), args.cases, args.generator)
+        folders = held_out.cases(os.path.join(tmp, "held-out"), args.cases, args.generator)
     else:
         folders = fm.multilabel_cases(args.cases) if args.multilabel else fm.cases(args.cases)
     for name, folder in folders.items():
