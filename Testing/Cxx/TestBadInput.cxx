@@ -2,6 +2,8 @@
 // malformed inputs and absurd properties. Each case asserts its outcome: a clear error naming the
 // problem and an empty output, or a correct result. ctest runs every case in its own process with
 // a time limit, so a crash or a hang fails one case, not the suite.
+#include "Contract.h"
+#include "SeedGeodesics.h"
 #include "vtkDelaunayImageMesh.h"
 #include "vtkFeatureNodes.h"
 #include "vtkImageMeshSmoothing.h"
@@ -1040,6 +1042,22 @@ TEST(SuperVoxelCut, NegativeGeodesicWeight)
   SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "geodesic weight"); },
     [](vtkSuperVoxelCut* f) { f->SetGeodesicWeight(-1); });
 }
+TEST(SuperVoxelCut, AdaptiveGeodesicWeightWhereTheSeedsLookAlike)
+{
+  // A constant image: both seeds' densities are the same (overlap 1), so the adaptive weight is at its
+  // largest, GeodesicWeight / SeedOverlapReference; the geodesic term alone places the cut.
+  auto image = Image({ { 32, 32, 1 } }, [](int, int, int) { return 7.0; });
+  auto mesh = MeshOf(image);
+  auto object = Points({ World(image, 8, 8, 0) }), background = Points({ World(image, 24, 24, 0) });
+  SuperVoxelCut(mesh, object, background, image, [&](auto& cut, const CutOutputs& out) {
+    ExpectGoodCut(cut, out, image, object, background);
+    vtkDataArray* overlap = out.Mesh->GetFieldData()->GetArray(featuremesh::names::SeedOverlap);
+    vtkDataArray* weight = out.Mesh->GetFieldData()->GetArray(featuremesh::names::SpatialWeight);
+    ASSERT_TRUE(overlap && weight);
+    EXPECT_NEAR(overlap->GetComponent(0, 0), 1.0, 1e-9);
+    EXPECT_NEAR(weight->GetComponent(0, 0), 1.5 / featuremesh::SeedOverlapReference, 1e-9);
+  });
+}
 TEST(SuperVoxelCut, NaNGeodesicLength)
 {
   Case2D c;
@@ -1145,6 +1163,19 @@ TEST(VoxelCut, BallWithMirroredSpacing)
   auto image = Ball();
   image->SetSpacing(-1.0, 1.0, 1.0);
   VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectGoodVoxelCut(run, out); });
+}
+TEST(VoxelCut, AdaptiveGeodesicWeightWhereTheSeedsLookAlike)
+{
+  auto image = Image({ { 32, 32, 1 } }, [](int, int, int) { return 7.0; });
+  auto object = Points({ World(image, 8, 8, 0) }), background = Points({ World(image, 24, 24, 0) });
+  VoxelCut(image, object, background, [&](auto& run, vtkImageData* labels) {
+    ExpectGoodVoxelCut(run, labels);
+    vtkDataArray* weight = labels->GetFieldData()->GetArray(featuremesh::names::SpatialWeight);
+    ASSERT_NE(weight, nullptr);
+    EXPECT_NEAR(weight->GetComponent(0, 0), 1.5 / featuremesh::SeedOverlapReference, 1e-9);
+    EXPECT_EQ(labels->GetPointData()->GetScalars()->GetComponent((8 * 32) + 8, 0), 1);
+    EXPECT_EQ(labels->GetPointData()->GetScalars()->GetComponent((24 * 32) + 24, 0), 0);
+  });
 }
 TEST(VoxelCut, EmptyImage)
 {
