@@ -154,8 +154,6 @@ def main():
         folders = fm.cases(args.cases)
     for name, folder in folders.items():
         case = fm.Case(folder)
-        if args.held_out:
-            case.task = "object"
         if case.truth() is None:
             print("%s: no truth.mha, skipped" % name)
             continue

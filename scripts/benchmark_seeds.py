@@ -178,8 +178,6 @@ def main():
         folders = fm.multilabel_cases(args.cases) if args.multilabel else fm.cases(args.cases)
     for name, folder in folders.items():
         case = fm.MultiLabelCase(folder) if args.multilabel else fm.Case(folder)
-        if args.held_out:
-            case.task = "object"
         if case.truth() is None:
             print("%s: no truth.mha, skipped" % name)
             continue

@@ -1055,7 +1055,7 @@ TEST(SuperVoxelCut, AdaptiveGeodesicWeightWhereTheSeedsLookAlike)
     vtkDataArray* weight = out.Mesh->GetFieldData()->GetArray(featuremesh::names::SpatialWeight);
     ASSERT_TRUE(overlap && weight);
     EXPECT_NEAR(overlap->GetComponent(0, 0), 1.0, 1e-9);
-    EXPECT_NEAR(weight->GetComponent(0, 0), 1.5 / featuremesh::SeedOverlapReference, 1e-9);
+    EXPECT_NEAR(weight->GetComponent(0, 0), featuremesh::SeedGeodesicParameters{}.Weight / featuremesh::SeedOverlapReference, 1e-9);
   });
 }
 TEST(SuperVoxelCut, NaNGeodesicLength)
@@ -1172,7 +1172,7 @@ TEST(VoxelCut, AdaptiveGeodesicWeightWhereTheSeedsLookAlike)
     ExpectGoodVoxelCut(run, labels);
     vtkDataArray* weight = labels->GetFieldData()->GetArray(featuremesh::names::SpatialWeight);
     ASSERT_NE(weight, nullptr);
-    EXPECT_NEAR(weight->GetComponent(0, 0), 1.5 / featuremesh::SeedOverlapReference, 1e-9);
+    EXPECT_NEAR(weight->GetComponent(0, 0), featuremesh::SeedGeodesicParameters{}.Weight / featuremesh::SeedOverlapReference, 1e-9);
     EXPECT_EQ(labels->GetPointData()->GetScalars()->GetComponent((8 * 32) + 8, 0), 1);
     EXPECT_EQ(labels->GetPointData()->GetScalars()->GetComponent((24 * 32) + 24, 0), 0);
   });

@@ -64,10 +64,12 @@ def cases(selection=()):
     return {k: v for k, v in found.items() if not selection or k in selection}
 
 
-def case_task(name):
-    """The task a case's seeds ask for ("object" or "class"), from the cases.csv beside it (the shared
-    data's, else Data/cases.csv); None when no list names it."""
-    for root in (os.path.join(SHARED, "cases"), DATA):
+def case_task(name, folder=None):
+    """The task a case's seeds ask for ("object" or "class"), from the cases.csv beside its `folder`
+    when given (a made case's list), else the shared data's, else Data/cases.csv; None when no list
+    names it."""
+    roots = [os.path.dirname(os.path.normpath(folder))] if folder else []
+    for root in roots + [os.path.join(SHARED, "cases"), DATA]:
         path = os.path.join(root, "cases.csv")
         if os.path.isfile(path):
             with open(path, newline="") as f:
@@ -228,7 +230,7 @@ class Case:
         self.object_seeds = seeds(object_seeds or os.path.join(folder, "seeds_object.csv"))
         self.background_seeds = seeds(background_seeds or os.path.join(folder, "seeds_background.csv"))
         self.is3d = fetch(self.image).GetDimensions()[2] > 1
-        self.task = case_task(self.name)
+        self.task = case_task(self.name, folder)
 
     def with_task(self, properties):
         """`properties` with Task set to the case's task, unless they set it."""

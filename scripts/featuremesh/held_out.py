@@ -29,31 +29,38 @@ HELD_OUT = [("abdomen-ct-totalseg", "abdomen-spleen", (2,), 0),
             ("brain-tumour-regions-brats-0006", "brats-0006-enhancing-t1c", (3,), 1)]
 
 
+def _read(path):
+    reader = vtkMetaImageReader()
+    reader.SetFileName(path)
+    reader.Update()
+    return reader.GetOutput()
+
+
 def cases(root, selection, generator):
     """{name: folder} of the held-out object cases (HELD_OUT), written under `root` as binary case
-    folders: one channel's image.mha, truth.mha and seed files drawn by the generator rule."""
+    folders (one channel's image.mha, truth.mha and seed files drawn by the generator rule) with a
+    cases.csv that gives each Task Object."""
     wanted = [c for c in selection.split(",") if c]
     found = fm.multilabel_cases()
+    sources = {}  # each multi-label case's image and label array, read once
     out = {}
     for source, name, labels, channel in HELD_OUT:
         if source not in found or (wanted and name not in wanted):
             continue
+        if source not in sources:
+            truth_image = _read(os.path.join(found[source], "truth.mha"))
+            sources[source] = (_read(os.path.join(found[source], "image.mha")), truth_image,
+                               fm.v2n(truth_image.GetPointData().GetScalars()))
+        multichannel, truth_image, label_array = sources[source]
         folder = os.path.join(root, name)
         os.makedirs(folder, exist_ok=True)
-        reader = vtkMetaImageReader()
-        reader.SetFileName(os.path.join(found[source], "image.mha"))
         extract = vtkImageExtractComponents()
-        extract.SetInputConnection(reader.GetOutputPort())
+        extract.SetInputData(multichannel)
         extract.SetComponents(channel)
         extract.Update()
         image = extract.GetOutput()
         image.GetPointData().GetScalars().SetName("Channel%d" % channel)
-        truth_reader = vtkMetaImageReader()
-        truth_reader.SetFileName(os.path.join(found[source], "truth.mha"))
-        truth_reader.Update()
-        truth_image = truth_reader.GetOutput()
-        labels_array = fm.v2n(truth_image.GetPointData().GetScalars())
-        truth = np.isin(labels_array, labels).astype(np.uint8)
+        truth = np.isin(label_array, labels).astype(np.uint8)
         mask = vtkImageData()
         mask.ShallowCopy(truth_image)
         mask.GetPointData().SetScalars(numpy_to_vtk(truth, deep=True))
@@ -71,4 +78,6 @@ def cases(root, selection, generator):
             np.savetxt(os.path.join(folder, file), origin + np.asarray(seeds, float) * spacing, delimiter=",",
                        header="x,y,z", comments="", fmt="%.6g")
         out[name] = folder
+    with open(os.path.join(root, "cases.csv"), "w") as f:
+        f.write("case,task\n" + "".join("%s,object\n" % name for name in out))
     return out
