@@ -148,8 +148,9 @@ def main():
     if not os.path.isdir(os.path.join(fm.SHARED, "cases")):
         print("shared data not found at %s: only the bundled cases run" % fm.SHARED)
     rows = []
+    scratch = tempfile.TemporaryDirectory(prefix="featuremesh-clicks-")  # removed at exit too
     if args.held_out:
-        folders = held_out.cases(os.path.join(tempfile.mkdtemp(), "held-out"), args.cases, 0)
+        folders = held_out.cases(os.path.join(scratch.name, "held-out"), args.cases, 0)
     else:
         folders = fm.cases(args.cases)
     for name, folder in folders.items():
@@ -163,6 +164,7 @@ def main():
             print("%s %s (%s): Dice %s, NoC@85 %d, NoC@90 %d, round %.3f s, lost seeds %d" % (
                 name, method, row["task"], " ".join("%.3f" % d for d in row["dice"]), row["noc85"], row["noc90"],
                 row["round_s"], row["lost_seeds"]), flush=True)
+    scratch.cleanup()
     os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
     with open(args.out + ".csv", "w", newline="") as f:
         w = csv.writer(f)

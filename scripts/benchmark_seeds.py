@@ -168,10 +168,11 @@ def main():
     fm.load_plugin()
     if not os.path.isdir(os.path.join(fm.SHARED, "cases")):
         print("shared data not found at %s: only the bundled cases run" % fm.SHARED)
-    rows = []
-    tmp = tempfile.mkdtemp()
     if args.multilabel and args.held_out:
         raise SystemExit("--multilabel and --held-out exclude each other")
+    rows = []
+    scratch = tempfile.TemporaryDirectory(prefix="featuremesh-seeds-")  # removed at exit too
+    tmp = scratch.name
     if args.held_out:
         folders = held_out.cases(os.path.join(tmp, "held-out"), args.cases, args.generator)
     else:
@@ -185,6 +186,7 @@ def main():
             rows += run_multilabel_case(case, methods, args.draws, args.generator, args.cut, tmp)
         else:
             rows += run_case(case, methods, args.draws, args.generator, args.cut)
+    scratch.cleanup()
     os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
     with open(args.out + ".csv", "w", newline="") as f:
         w = csv.writer(f)

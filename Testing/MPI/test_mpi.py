@@ -5,7 +5,6 @@ import os
 import shutil
 import subprocess
 import sys
-import tempfile
 
 import fmtest as ft
 from vtkmodules.vtkIOXML import vtkXMLPImageDataReader, vtkXMLPUnstructuredGridReader
@@ -14,7 +13,7 @@ mpirun, pvbatch = shutil.which("mpirun"), shutil.which("pvbatch")
 if not mpirun or not pvbatch:
     print("SKIP: mpirun or pvbatch not found")
     sys.exit(ft.SKIP)
-out = tempfile.mkdtemp(prefix="featuremesh-mpi-")
+out = ft.scratch("featuremesh-mpi-")
 command = [mpirun, "-np", "2"] + (["--allow-run-as-root", "--oversubscribe"] if os.geteuid() == 0 else ["--oversubscribe"]) + [
     pvbatch, os.path.join(os.path.dirname(os.path.abspath(__file__)), "save_pipeline.py"), out]
 # pvpython initialised MPI as a singleton: its OMPI_/PMIX_ variables would make mpirun fail.

@@ -5,6 +5,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 
 import featuremesh as fm
 from featuremesh import dice, fetch, names, np, seeds, v2n  # noqa: F401
@@ -136,3 +137,28 @@ def finish(what=None):
 
 
 atexit.register(finish)
+
+_RAISED = []
+
+
+def _excepthook(kind, value, trace):
+    _RAISED.append(kind)
+    sys.__excepthook__(kind, value, trace)
+
+
+sys.excepthook = _excepthook
+
+
+def scratch(prefix="featuremesh-test-"):
+    """A new temporary folder for a test's files. It is removed when the test passes and kept (its
+    path printed) when a check fails, an exception escapes, or FEATUREMESH_KEEP_SCRATCH is set."""
+    folder = tempfile.mkdtemp(prefix=prefix)
+
+    def remove():
+        if FAILURES or _RAISED or os.environ.get("FEATUREMESH_KEEP_SCRATCH"):
+            print("kept", folder, flush=True)
+        else:
+            shutil.rmtree(folder, ignore_errors=True)
+
+    atexit.register(remove)
+    return folder

@@ -7,11 +7,10 @@ import os
 import re
 import shutil
 import subprocess
-import tempfile
 
 import fmtest as ft
 
-out = os.path.join(tempfile.mkdtemp(), "bench")
+out = os.path.join(ft.scratch(), "bench")
 env = dict(os.environ, FEATUREMESH_SHARED_DATA=os.path.join(out, "absent"))
 script = os.path.join(ft.fm.ROOT, "scripts", "benchmark.py")
 run = subprocess.run([shutil.which("pvpython"), script, "--runs", "1", "--out", out], env=env, capture_output=True, text=True)

@@ -5,11 +5,10 @@ import csv
 import os
 import shutil
 import subprocess
-import tempfile
 
 import fmtest as ft
 
-out = os.path.join(tempfile.mkdtemp(), "clicks")
+out = os.path.join(ft.scratch(), "clicks")
 script = os.path.join(ft.fm.ROOT, "scripts", "benchmark_clicks.py")
 run = subprocess.run([shutil.which("pvpython"), script, "--cases", "nuclei-dsb2018,liver-ct-totalseg", "--rounds", "2",
                       "--out", out], capture_output=True, text=True)

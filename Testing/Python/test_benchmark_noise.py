@@ -6,11 +6,10 @@ import csv
 import os
 import shutil
 import subprocess
-import tempfile
 
 import fmtest as ft
 
-out = os.path.join(tempfile.mkdtemp(), "noise")
+out = os.path.join(ft.scratch(), "noise")
 script = os.path.join(ft.fm.ROOT, "scripts", "benchmark_noise.py")
 run = subprocess.run([shutil.which("pvpython"), script, "--cases", "liver-ct-totalseg", "--levels", "0,0.1", "--out", out],
                      capture_output=True, text=True)

@@ -6,11 +6,10 @@ import csv
 import os
 import shutil
 import subprocess
-import tempfile
 
 import fmtest as ft
 
-out = os.path.join(tempfile.mkdtemp(), "scale")
+out = os.path.join(ft.scratch(), "scale")
 script = os.path.join(ft.fm.ROOT, "scripts", "benchmark_scale.py")
 run = subprocess.run([shutil.which("pvpython"), script, "--case", "liver-ct-totalseg", "--sizes", "1x,2x", "--hugepages", "--out", out],
                      capture_output=True, text=True)

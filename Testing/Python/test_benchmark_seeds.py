@@ -7,7 +7,6 @@ import csv
 import os
 import shutil
 import subprocess
-import tempfile
 
 import numpy as np
 from scipy import ndimage as ndi
@@ -41,7 +40,7 @@ try:
 except ValueError:
     pass
 
-out = os.path.join(tempfile.mkdtemp(), "seeds")
+out = os.path.join(ft.scratch(), "seeds")
 script = os.path.join(ft.fm.ROOT, "scripts", "benchmark_seeds.py")
 run = subprocess.run([shutil.which("pvpython"), script, "--cases", "nuclei-dsb2018,liver-ct-totalseg", "--draws", "5",
                       "--methods", "supervoxel,voxel", "--out", out], capture_output=True, text=True)

@@ -6,7 +6,6 @@ import os
 import re
 import shutil
 import subprocess
-import tempfile
 
 import fmtest as ft
 from featuremesh import fem
@@ -28,7 +27,7 @@ def labelled_meshes():
     yield "abdomen", ft.fetch(ft.ps.SegmentationSurfaceSmoothing(LabelledMesh=ft.ps.OutputPort(cut, 0)), 1)
 
 
-out = tempfile.mkdtemp(prefix="featuremesh-calculix-")
+out = ft.scratch("featuremesh-calculix-")
 for name, grid in labelled_meshes():
     points, cells, labels = fem.grid_arrays(grid)
     mesh_file = fem.write(grid, os.path.join(out, name), formats=("abaqus",))["abaqus"]

@@ -1,14 +1,13 @@
 """Export: every .vtu FeatureMesh writes (stage 2's mesh, stage 4's labelled mesh; 2D and 3D) reads
 back in meshio with its points, cells and cell arrays intact, and the label images as .vti in VTK."""
 import os
-import tempfile
 
 import meshio
 from vtkmodules.vtkIOXML import vtkXMLImageDataReader, vtkXMLImageDataWriter, vtkXMLUnstructuredGridWriter
 
 import fmtest as ft
 
-out = tempfile.mkdtemp(prefix="featuremesh-export-")
+out = ft.scratch("featuremesh-export-")
 for case in ("nuclei-dsb2018", "liver-ct-totalseg"):
     c = ft.fm.Case(ft.case_dir(case))
     nodes, mesh, cut = c.pipeline()

@@ -6,7 +6,6 @@ import json
 import os
 import shutil
 import subprocess
-import tempfile
 
 from vtkmodules.vtkImagingCore import vtkImageFlip
 from vtkmodules.vtkIOImage import vtkPNGWriter
@@ -14,7 +13,7 @@ from vtkmodules.vtkIOImage import vtkPNGWriter
 import fmtest as ft
 
 np = ft.np
-out = tempfile.mkdtemp(prefix="featuremesh-formats-")
+out = ft.scratch("featuremesh-formats-")
 d = ft.case_dir("nuclei-dsb2018")
 mha = ft.ps.OpenDataFile(os.path.join(d, "image.mha"))
 image = ft.fetch(mha)

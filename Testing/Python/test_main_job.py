@@ -7,12 +7,11 @@ import json
 import os
 import shutil
 import subprocess
-import tempfile
 
 import fmtest as ft
 
 d = ft.case_dir("nuclei-dsb2018")
-out = tempfile.mkdtemp()
+out = ft.scratch()
 script = os.path.join(ft.fm.ROOT, "scripts", "featuremesh_segment.py")
 run = subprocess.run([shutil.which("pvpython"), script, os.path.join(d, "image.mha"),
                       "--object-seeds", os.path.join(d, "seeds_object.csv"),

@@ -8,14 +8,13 @@ collision fails or one with a collision reads: either would change what the READ
 import math
 import os
 import re
-import tempfile
 
 import meshio
 
 import fmtest as ft
 
 np = ft.np
-out = tempfile.mkdtemp(prefix="featuremesh-meshio-")
+out = ft.scratch("featuremesh-meshio-")
 
 
 def offset_collisions(path):

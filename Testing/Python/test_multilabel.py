@@ -5,7 +5,6 @@ re-cuts the kept mesh; stage 6 smooths every interface with no inverted element;
 back in meshio with a region per label named after it and a tag per pair of touching labels. The
 two-channel BraTS tumour regions (shared data only) keep their mean floors."""
 import os
-import tempfile
 
 import meshio
 
@@ -69,7 +68,7 @@ for name, folder in cases.items():
     ft.check(held == len(case.seed_rows()), "%s: on the local contrast every seed keeps its label" % name)
     # A seed edit: one more liver seed; only the cut re-runs, and the seeds still hold.
     rows = case.seed_rows() + [(case.seed_rows()[0][0] + 6.0, case.seed_rows()[0][1], case.seed_rows()[0][2], 1)]
-    path = os.path.join(tempfile.mkdtemp(prefix="featuremesh-multilabel-"), "seeds.csv")
+    path = os.path.join(ft.scratch("featuremesh-multilabel-"), "seeds.csv")
     with open(path, "w") as f:
         f.write("x,y,z,label\n" + "".join("%g,%g,%g,%d\n" % r for r in rows))
     cut.Seeds = ft.ps.CSVReader(FileName=[path])
@@ -131,7 +130,7 @@ for name, folder in cases.items():
         edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [0, 2]]]), axis=1)
         _, counts = np.unique(edges, axis=0, return_counts=True)
         ft.check((counts % 2 == 0).all(), "%s: the boundary of %s is closed" % (name, region[l]))
-    out = tempfile.mkdtemp(prefix="featuremesh-multilabel-fem-")
+    out = ft.scratch("featuremesh-multilabel-fem-")
     files = fem.write(grid, os.path.join(out, name))
     names = fem.tag_names(3, region)
     pair_names = sorted(names[t] for t in set(tags.tolist()) if t >= fem.PAIR_TAG0)

@@ -5,14 +5,13 @@ import json
 import os
 import shutil
 import subprocess
-import tempfile
 
 import nibabel
 
 import fmtest as ft
 
 np = ft.np
-out = tempfile.mkdtemp(prefix="featuremesh-nifti-")
+out = ft.scratch("featuremesh-nifti-")
 
 
 def to_nifti(mha, path):

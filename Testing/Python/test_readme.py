@@ -4,7 +4,6 @@ import os
 import re
 import shutil
 import subprocess
-import tempfile
 
 from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
 
@@ -16,7 +15,7 @@ ft.check(len(blocks) == 1, "the README has one pvpython snippet")
 code = blocks[0]
 ft.check('FM = "/path/to/FeatureMesh"' in code, "the snippet says where to point FM")
 code = code.replace('FM = "/path/to/FeatureMesh"', "FM = %r" % ft.fm.ROOT)
-work = tempfile.mkdtemp(prefix="featuremesh-readme-")
+work = ft.scratch("featuremesh-readme-")
 with open(os.path.join(work, "snippet.py"), "w") as f:
     f.write(code)
 # The snippet's plugin path is the build tree's; point it at this build's plugin when that differs.

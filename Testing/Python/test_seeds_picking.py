@@ -4,7 +4,6 @@ Super-Voxel Cut's seed ports as they are; the cut equals the one from the same p
 CSV and read through the CSV reader and Table To Points. Each pick lands within two pixels' worth
 of voxels of where it was aimed."""
 import os
-import tempfile
 
 import fmtest as ft
 
@@ -41,7 +40,7 @@ def picked(csv):
 
 
 seeds = {}
-out = tempfile.mkdtemp(prefix="featuremesh-picking-")
+out = ft.scratch("featuremesh-picking-")
 for kind in ("object", "background"):
     frozen, aimed, got = picked(os.path.join(d, "seeds_%s.csv" % kind))
     ft.check(len(got) == len(aimed), "%s: one point per click (%d of %d)" % (kind, len(got), len(aimed)))

@@ -5,7 +5,6 @@ from the values; a change of the values (Modified) must drop them, also where a 
 kept label image in place. Bundled cases: the liver (3D, every filter), nuclei (2D) and the
 abdomen's labelled seeds."""
 import os
-import tempfile
 
 import fmtest as ft
 import paraview.simple as ps
@@ -99,7 +98,7 @@ if os.path.isdir(abdomen):
     image = ps.OpenDataFile(os.path.join(abdomen, "image.mha"))
     mesh = ps.ImageMeshSmoothing(Mesh=ps.DelaunayImageMesh(Nodes=ps.FeatureNodes(Input=image), Image=image), Image=image)
     rows = ft.np.loadtxt(os.path.join(abdomen, "seeds.csv"), delimiter=",", skiprows=1, ndmin=2)
-    folder = tempfile.mkdtemp()
+    folder = ft.scratch()
     multi = None
     for k in (5, 3, 4, 2):
         path = os.path.join(folder, "seeds_%d.csv" % k)
