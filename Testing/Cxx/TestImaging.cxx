@@ -121,12 +121,16 @@ TEST(PCA, ThinningMatchesTheGreedyDefinition)
 {
   // Random 3D points, radii up to 4 (the distance-map path) and up to 12 (the bucket-grid path),
   // against the O(n^2) definition: visit by (radius, index); keep a point when no kept point lies
-  // within its (2R+1)-box.
+  // within its (2R+1)-box. Radii are in voxels of the median axis: with slices half as thick as
+  // the in-plane spacing the box spans (2R+1) x (2R+1) x (4R+1) voxels.
   ImageGeometry g;
   g.Dims = { { 40, 30, 20 } };
   std::mt19937 rng(3);
+  for (const int thin : { 1, 2 })
   for (int largest : { 4, 12 })
   {
+    g.Spacing = { { 1.0, 1.0, 1.0 / thin } };
+    ASSERT_EQ(g.MedianVoxelFactors()[2], thin);
     std::vector<std::int64_t> pts;
     std::vector<std::uint8_t> radii;
     std::uniform_int_distribution<std::int64_t> voxel(0, g.Size() - 1);
@@ -154,14 +158,15 @@ TEST(PCA, ThinningMatchesTheGreedyDefinition)
       for (std::int64_t q : want)
       {
         const auto a = xyz(pts[t]), b = xyz(pts[q]);
-        blocked |= std::abs(a[0] - b[0]) <= radii[t] && std::abs(a[1] - b[1]) <= radii[t] && std::abs(a[2] - b[2]) <= radii[t];
+        blocked |= std::abs(a[0] - b[0]) <= radii[t] && std::abs(a[1] - b[1]) <= radii[t] &&
+          std::abs(a[2] - b[2]) <= thin * radii[t];
       }
       if (!blocked)
       {
         want.push_back(t);
       }
     }
-    EXPECT_EQ(ThinEdgePoints(pts, radii, g), want) << "radii up to " << largest;
+    EXPECT_EQ(ThinEdgePoints(pts, radii, g), want) << "radii up to " << largest << ", slices 1/" << thin;
   }
 }
 

@@ -55,6 +55,19 @@ struct ImageGeometry
     std::sort(s.begin(), s.end());
     return s[1];
   }
+  // Per axis, how many of its voxels span one voxel of the median axis, rounded, at least 1: 1 on
+  // every axis but one thinner than the other two. Distances in voxels measured with these
+  // factors are even in world units where an axis is thin, as the median axis's elsewhere.
+  std::array<int, 3> MedianVoxelFactors() const
+  {
+    const double unit = MedianSpacing();
+    std::array<int, 3> m{ { 1, 1, 1 } };
+    for (int a = 0; a < Dimension(); ++a)
+    {
+      m[a] = std::max(1, static_cast<int>(std::lround(unit / std::fabs(Spacing[a]))));
+    }
+    return m;
+  }
   std::int64_t SliceStride() const { return static_cast<std::int64_t>(Dims[0]) * Dims[1]; }
   // The (i, j, k) of a voxel index: the inverse of Index.
   std::array<int, 3> Coordinates(std::int64_t v) const

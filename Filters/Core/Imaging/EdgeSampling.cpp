@@ -201,6 +201,12 @@ std::vector<std::int64_t> ThinEdgePoints(
     order[first[radii[t]]++] = static_cast<std::int64_t>(t);
   }
 
+  // Radii are in voxels of the median axis: along an axis thinner than the other two, |d| voxels
+  // count as ceil(|d| / m) (ImageGeometry::MedianVoxelFactors), so that kept points are not denser
+  // across thin slices, which left flat tetrahedra stage 3 could not mend (docs/smoothing.md).
+  const std::array<int, 3> m = g.MedianVoxelFactors();
+  auto along = [&m](int a, int d) { return (std::abs(d) + m[a] - 1) / m[a]; };
+
   // Small radii (all the defaults): a map of the Chebyshev distance to the nearest kept point,
   // capped past the largest radius, stamped around each kept point. A point is blocked exactly when
   // that distance is at most its radius: one lookup per query.
@@ -211,7 +217,7 @@ std::vector<std::int64_t> ThinEdgePoints(
     const std::uint8_t far = static_cast<std::uint8_t>(largest + 1);
     std::vector<std::uint8_t> distance(static_cast<std::size_t>(g.Size()), far);
     std::vector<std::int64_t> kept;
-    const int kr = g.Is2D() ? 0 : largest;
+    const int ir = largest * m[0], jr = largest * m[1], kr = g.Is2D() ? 0 : largest * m[2];
     for (std::int64_t t : order)
     {
       if (distance[pts[t]] <= radii[t])
@@ -223,13 +229,13 @@ std::vector<std::int64_t> ThinEdgePoints(
       Coordinates(g, pts[t], i, j, k);
       for (int dk = std::max(-kr, -k); dk <= std::min(kr, g.Dims[2] - 1 - k); ++dk)
       {
-        for (int dj = std::max(-largest, -j); dj <= std::min(largest, g.Dims[1] - 1 - j); ++dj)
+        for (int dj = std::max(-jr, -j); dj <= std::min(jr, g.Dims[1] - 1 - j); ++dj)
         {
           std::uint8_t* row = distance.data() + g.Index(0, j + dj, k + dk);
-          const int dkj = std::max(std::abs(dk), std::abs(dj));
-          for (int di = std::max(-largest, -i); di <= std::min(largest, g.Dims[0] - 1 - i); ++di)
+          const int dkj = std::max(along(2, dk), along(1, dj));
+          for (int di = std::max(-ir, -i); di <= std::min(ir, g.Dims[0] - 1 - i); ++di)
           {
-            const std::uint8_t d = static_cast<std::uint8_t>(std::max(dkj, std::abs(di)));
+            const std::uint8_t d = static_cast<std::uint8_t>(std::max(dkj, along(0, di)));
             row[i + di] = std::min(row[i + di], d);
           }
         }
@@ -250,18 +256,18 @@ std::vector<std::int64_t> ThinEdgePoints(
   {
     int i, j, k;
     Coordinates(g, pts[t], i, j, k);
-    const int r = radii[t];
+    const int ri = radii[t] * m[0], rj = radii[t] * m[1], rk = radii[t] * m[2];
     bool blocked = false;
-    for (int bz = std::max(0, (k - r) / cell); !blocked && bz <= std::min(cz - 1, (k + r) / cell); ++bz)
+    for (int bz = std::max(0, (k - rk) / cell); !blocked && bz <= std::min(cz - 1, (k + rk) / cell); ++bz)
     {
-      for (int by = std::max(0, (j - r) / cell); !blocked && by <= std::min(cy - 1, (j + r) / cell); ++by)
+      for (int by = std::max(0, (j - rj) / cell); !blocked && by <= std::min(cy - 1, (j + rj) / cell); ++by)
       {
-        for (int bx = std::max(0, (i - r) / cell); !blocked && bx <= std::min(cx - 1, (i + r) / cell); ++bx)
+        for (int bx = std::max(0, (i - ri) / cell); !blocked && bx <= std::min(cx - 1, (i + ri) / cell); ++bx)
         {
           for (std::int64_t q = head[(static_cast<size_t>(bz) * cy + by) * cx + bx]; q >= 0; q = next[q])
           {
             const auto& o = keptPos[q];
-            if (std::abs(o[0] - i) <= r && std::abs(o[1] - j) <= r && std::abs(o[2] - k) <= r)
+            if (std::abs(o[0] - i) <= ri && std::abs(o[1] - j) <= rj && std::abs(o[2] - k) <= rk)
             {
               blocked = true;
               break;
