@@ -61,6 +61,10 @@ void SetClampedParameter(vtkObject* filter, Parameter& parameter, int value, int
   double cls::GetGeodesicLength() { return this->Geodesic.LengthWeight; }                                          \
   void cls::SetAdaptiveGeodesicWeight(bool value) { featuremesh::SetParameter(this, this->Geodesic.Adaptive, value); } \
   bool cls::GetAdaptiveGeodesicWeight() { return this->Geodesic.Adaptive; }                                        \
+  void cls::SetSeedReach(double value) { featuremesh::SetParameter(this, this->featuremesh::SeededCutParameters::Reach.Reach, value); } \
+  double cls::GetSeedReach() { return this->featuremesh::SeededCutParameters::Reach.Reach; }                      \
+  void cls::SetSeedReachWeight(double value) { featuremesh::SetParameter(this, this->featuremesh::SeededCutParameters::Reach.Weight, value); } \
+  double cls::GetSeedReachWeight() { return this->featuremesh::SeededCutParameters::Reach.Weight; }               \
   void cls::SetChannelModel(int value) { featuremesh::SetClampedParameter(this, this->Channels, value, 0, 2); }    \
   int cls::GetChannelModel() { return static_cast<int>(this->Channels); }
 

@@ -408,7 +408,8 @@ featuremesh::VoxelRefinementResult vtkSuperVoxelCut::RefineBinary(featuremesh::S
     [&](std::int64_t v, std::int64_t e, double* costs) {
       const int b = cut.ValueBin(value(v));
       costs[0] = lambda * (cut.BinCostBackground[b] + (spatial ? cut.SpatialScale * cut.SpatialBackground[e] : 0.0));
-      costs[1] = lambda * (cut.BinCostObject[b] + (spatial ? cut.SpatialScale * cut.SpatialObject[e] : 0.0));
+      costs[1] = lambda * (cut.BinCostObject[b] + (spatial ? cut.SpatialScale * cut.SpatialObject[e] : 0.0) +
+                            (cut.Reach.empty() ? 0.0 : cut.Reach[e]));
     },
     &result.ObjectComponent, 0.9);
   // The components' volumes hold the refined voxels too.
@@ -436,11 +437,13 @@ featuremesh::VoxelRefinementResult vtkSuperVoxelCut::RefineLabels(
   const std::vector<std::uint16_t>& bin = data.Bins.Bin;
   const std::vector<double>& size = data.ChannelCount;
   const SharedArray<double>& spatial = result.Spatial;
+  const SharedArray<double>& reach = result.Reach;
   return this->Refine(result.Label, L, values, seeds.Voxel,
     [&](std::int64_t v, std::int64_t e, double* costs) {
       for (int l = 0; l < L; ++l)
       {
-        costs[l] = lambda * binCosts[l][bin[v]] + (spatial.empty() || !(size[e] > 0.0) ? 0.0 : spatial[e * L + l] / size[e]);
+        costs[l] = lambda * binCosts[l][bin[v]] + (spatial.empty() || !(size[e] > 0.0) ? 0.0 : spatial[e * L + l] / size[e]) +
+          (l == 0 || reach.empty() ? 0.0 : lambda * reach[e * (L - 1) + l - 1]);
       }
     },
     nullptr, 0.9);
@@ -678,6 +681,8 @@ void vtkSuperVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
      << indent << "GeodesicWeight: " << this->GetGeodesicWeight() << "\n"
      << indent << "GeodesicLength: " << this->GetGeodesicLength() << "\n"
      << indent << "AdaptiveGeodesicWeight: " << this->GetAdaptiveGeodesicWeight() << "\n"
+     << indent << "SeedReach: " << this->GetSeedReach() << "\n"
+     << indent << "SeedReachWeight: " << this->GetSeedReachWeight() << "\n"
      << indent << "Bandwidth: " << this->Bandwidth << "\n"
      << indent << "SuperVoxelIds: " << this->SuperVoxelIds << "\n"
      << indent << "ScaleByContact: " << this->ScaleByContact << "\n"

@@ -191,6 +191,8 @@ void vtkVoxelCut::PrintSelf(ostream& os, vtkIndent indent)
      << indent << "GeodesicWeight: " << this->GetGeodesicWeight() << "\n"
      << indent << "GeodesicLength: " << this->GetGeodesicLength() << "\n"
      << indent << "AdaptiveGeodesicWeight: " << this->GetAdaptiveGeodesicWeight() << "\n"
+     << indent << "SeedReach: " << this->GetSeedReach() << "\n"
+     << indent << "SeedReachWeight: " << this->GetSeedReachWeight() << "\n"
      << indent << "Bandwidth: " << this->Bandwidth << "\n"
      << indent << "SeedRadius: " << this->SeedRadius << "\n"
      << indent << "SeedLabelArray: " << this->SeedLabelArray << "\n"

@@ -78,6 +78,13 @@ public:
   virtual void SetAdaptiveGeodesicWeight(bool value);
   virtual bool GetAdaptiveGeodesicWeight();
   vtkBooleanMacro(AdaptiveGeodesicWeight, bool);
+  /// Task Object: where the seeds' reach starts, in units of R, the largest distance from an object
+  /// seed to the nearest background seed (featuremesh::SeedReachParameters; default 1).
+  virtual void SetSeedReach(double value);
+  virtual double GetSeedReach();
+  /// Cost per voxel of the object one R beyond Seed Reach, growing linearly (default 4; 0 = off).
+  virtual void SetSeedReachWeight(double value);
+  virtual double GetSeedReachWeight();
   /// Kernel bandwidth of the seed histograms as a multiple of Silverman's rule (default 1).
   vtkSetMacro(Bandwidth, double);
   vtkGetMacro(Bandwidth, double);

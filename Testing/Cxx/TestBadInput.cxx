@@ -1064,6 +1064,28 @@ TEST(SuperVoxelCut, NaNGeodesicLength)
   SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "geodesic length"); },
     [](vtkSuperVoxelCut* f) { f->SetGeodesicLength(NaN); });
 }
+TEST(SuperVoxelCut, NegativeSeedReachWeight)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "seed reach weight"); },
+    [](vtkSuperVoxelCut* f) { f->SetSeedReachWeight(-1); });
+}
+TEST(SuperVoxelCut, NaNSeedReach)
+{
+  Case2D c;
+  SuperVoxelCut(c.mesh, c.object, c.background, c.image, [](auto& cut, const CutOutputs& out) { ExpectCutError(cut, out, "seed reach"); },
+    [](vtkSuperVoxelCut* f) { f->SetSeedReach(NaN); });
+}
+TEST(SuperVoxelCut, SeedReachWithSeedsAFewVoxelsApart)
+{
+  // Seeds four voxels apart: R is four voxels, and all but a small disc round the object seed pays
+  // the reach term; the cut keeps its seeds and gives a valid result.
+  auto image = Image({ { 32, 32, 1 } }, [](int i, int, int) { return i < 16 ? 10.0 : 20.0; });
+  auto mesh = MeshOf(image);
+  auto object = Points({ World(image, 13, 16, 0) }), background = Points({ World(image, 17, 16, 0) });
+  SuperVoxelCut(mesh, object, background, image,
+    [&](auto& cut, const CutOutputs& out) { ExpectGoodCut(cut, out, image, object, background); });
+}
 TEST(SuperVoxelCut, ClassTaskKeepsTheSeeds)
 {
   Case2D c;
@@ -1211,6 +1233,12 @@ TEST(VoxelCut, SeedRadiusOutOfRange)
   auto image = Disc();
   VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "seed radius", out); },
     [](vtkVoxelCut* f) { f->SetSeedRadius(1000); });
+}
+TEST(VoxelCut, NegativeSeedReachWeight)
+{
+  auto image = Disc();
+  VoxelCut(image, ObjectSeeds(image), BackgroundSeeds(image), [](auto& run, vtkImageData* out) { ExpectError(run, "seed reach weight", out); },
+    [](vtkVoxelCut* f) { f->SetSeedReachWeight(-1); });
 }
 TEST(VoxelCut, NegativeBandwidth)
 {

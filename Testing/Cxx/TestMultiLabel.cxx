@@ -403,6 +403,53 @@ TEST(MultiLabel, ThreePlateausAreTheLabelsOnVoxelsAndElements)
   }
 }
 
+TEST(MultiLabel, TheSeedReachStopsALeakAlongABridge)
+{
+  // Label 1's disk is joined by a bright bridge to a look-alike disk far away; label 2 is a dimmer
+  // disk, and background seeds ring label 1's. Without the reach term both cuts give the far disk
+  // to label 1 (its appearance, no edge along the bridge, one piece with the seeded disk); with it
+  // (default) the far disk is background, and the seeded disks keep their labels.
+  const ImageGeometry g = Grid(96, 32);
+  std::mt19937 rng(3);
+  std::normal_distribution<float> noise(0.f, 3.f);
+  const std::vector<float> image = Image(g, 1, [&](int i, int j, int) {
+    if (std::hypot(i - 14, j - 16) <= 7 || std::hypot(i - 80, j - 16) <= 7 || (std::abs(j - 16) <= 2 && i > 14 && i < 80))
+      return 100.f + noise(rng);
+    return (std::hypot(i - 46, j - 6) <= 5 ? 60.f : 20.f) + noise(rng);
+  });
+  LabelledSeeds seeds;
+  for (auto [i, j] : { std::pair<int, int>{ 14, 16 }, { 11, 14 }, { 16, 19 } })
+  {
+    seeds.Voxel.push_back(g.Index(i, j, 0));
+    seeds.Label.push_back(1);
+  }
+  seeds.Voxel.push_back(g.Index(46, 6, 0));
+  seeds.Label.push_back(2);
+  for (double a : { 0.8, 1.57, 2.36, 3.14, 3.93, 4.71, 5.5 })
+  {
+    seeds.Voxel.push_back(g.Index(int(14 + 11 * std::cos(a)), int(16 + 11 * std::sin(a)), 0));
+    seeds.Label.push_back(0);
+  }
+  Lattice m;
+  ASSERT_TRUE(m.Make(g, image, 1));
+  for (double weight : { 0.0, SeedReachParameters().Weight })
+  {
+    VoxelCutParameters vp;
+    vp.Reach.Weight = weight;
+    SuperVoxelCutParameters sp;
+    sp.Reach.Weight = weight;
+    const std::vector<std::uint8_t> voxel = VoxelCutLabels(g, image, 1, seeds, vp);
+    const std::vector<std::uint8_t> super = m.Cut(seeds, sp);
+    for (const auto* label : { &voxel, &super })
+    {
+      const char* what = label == &super ? "elements" : "voxels";
+      EXPECT_EQ((*label)[g.Index(14, 16, 0)], 1) << what << ", reach weight " << weight;
+      EXPECT_EQ((*label)[g.Index(46, 6, 0)], 2) << what << ", reach weight " << weight;
+      EXPECT_EQ((*label)[g.Index(80, 16, 0)], weight > 0 ? 0 : 1) << what << ", reach weight " << weight;
+    }
+  }
+}
+
 TEST(MultiLabel, TheSameLabelsOnAnyThreads)
 {
   const Plateaus p;

@@ -479,6 +479,7 @@ std::string ValidateProblem(const CutProblem& pr, const ProgressFunction& progre
     (edges.IsGrid() && static_cast<std::int64_t>(dims[0]) * dims[1] * dims[2] != n) ||
     (!pr.Contact.empty() && static_cast<std::int64_t>(pr.Contact.size()) != m) ||
     (!pr.Step.empty() && static_cast<std::int64_t>(pr.Step.size()) != m) ||
+    (!pr.Reach.empty() && static_cast<std::int64_t>(pr.Reach.size()) != n) ||
     (pr.NodeVoxels && (pr.NodeVoxels->Nodes != n || pr.NodeVoxels->Empty())))
   {
     return "the graph's arrays disagree in length.";
@@ -1060,14 +1061,19 @@ bool ScaleRegionCosts(const CutProblem& pr, const SharedArray<double>& spatialOb
   const SharedArray<double>& spatialBackground, double lambda, std::int64_t n, double* regionObject,
   double* regionBackground, double& total, const ProgressFunction& progress, double spatialScale)
 {
-  const bool spatial = !spatialObject.empty();
+  const bool spatial = !spatialObject.empty(), reach = !pr.Reach.empty();
   for (std::int64_t p = 0; p < n; ++p)
   {
+    const double size = pr.Size.empty() ? 1.0 : pr.Size[p];
     if (spatial)
     {
-      const double size = pr.Size.empty() ? 1.0 : pr.Size[p];
       regionObject[p] += spatialScale * size * spatialObject[p];
       regionBackground[p] += spatialScale * size * spatialBackground[p];
+    }
+    if (reach)
+    {
+      // Not scaled by the seeds' overlap: where the object lies does not follow how it looks.
+      regionObject[p] += size * pr.Reach[p];
     }
     regionObject[p] *= lambda;
     regionBackground[p] *= lambda;
@@ -1146,8 +1152,11 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   if (aborted(RegionCosts(pr, bin, costs, low, width, cache ? &cache->Binned : nullptr, regionObject.get(),
         regionBackground.get(), SubProgress(progress, 0.2, 0.3))) ||
     aborted(SeedGeodesicTerm(pr, lattice.HistogramHigh() - lattice.HistogramLow(), cache ? &cache->Geodesic : nullptr,
-      spatialObject, spatialBackground, SubProgress(progress, 0.3, 0.33), r.GeodesicSeconds)) ||
-    aborted(ScaleRegionCosts(pr, spatialObject, spatialBackground, par.Lambda, n, regionObject.get(), regionBackground.get(),
+      spatialObject, spatialBackground, SubProgress(progress, 0.3, 0.33), r.GeodesicSeconds)))
+  {
+    return r;
+  }
+  if (aborted(ScaleRegionCosts(pr, spatialObject, spatialBackground, par.Lambda, n, regionObject.get(), regionBackground.get(),
       total, SubProgress(progress, 0.33, 0.35), r.SpatialScale)) ||
     aborted(progress(0.35)))
   {
@@ -1222,6 +1231,7 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   r.BinCostBackground = costs.Background;
   r.SpatialObject = spatialObject;
   r.SpatialBackground = spatialBackground;
+  r.Reach = pr.Reach;
   // 8. What a re-cut with other seeds reuses: the graph, its weights and its capacities.
   if (cache)
   {

@@ -113,6 +113,8 @@ struct CutProblem
   // length of each explicit edge in voxels (empty: 1 each, the voxel grid).
   SeedGeodesicParameters Geodesic{ 0.0 };
   SharedArray<double> Step;
+  // The seeds' reach (SeedReach.h): each node's cost per voxel as object; empty = none.
+  SharedArray<double> Reach;
   // How loops over nodes may split across threads.
   ParallelFor Parallel = SerialFor();
 };
@@ -147,6 +149,8 @@ struct CutResult
   ValueBins ValueBin;
   std::vector<double> BinCostObject, BinCostBackground;
   SharedArray<double> SpatialObject, SpatialBackground;
+  // The seeds' reach per voxel of each node as object (CutProblem::Reach), not scaled; empty = none.
+  SharedArray<double> Reach;
   // The seed densities' overlap (Bhattacharyya coefficient) and the spatial term's weight this cut
   // used; SpatialObject / SpatialBackground are at Geodesic.Weight, and SpatialScale takes them to it.
   double SeedOverlap = 0.0, SpatialWeight = 0.0, SpatialScale = 1.0;

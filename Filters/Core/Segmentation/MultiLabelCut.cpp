@@ -340,8 +340,8 @@ std::string CheckInputs(const LabelledSeeds& seeds, bool sizesMatch, const char*
 void SolveLabels(PottsProblem& pr, std::vector<std::int16_t> hard, const std::vector<double>& mean, const ChannelBins& bins,
   const SharedArray<double>& step, const std::vector<double>& contact, const std::vector<double>& size,
   const std::vector<std::uint8_t>& border, const SeededCutParameters& par, const MultiLabelParameters& multi,
-  std::vector<std::uint8_t> start, const ParallelFor& parallel, const ProgressFunction& progress, MultiLabelCache* cache,
-  Clock::time_point t0, MultiLabelResult& r)
+  std::vector<double> reach, std::vector<std::uint8_t> start, const ParallelFor& parallel,
+  const ProgressFunction& progress, MultiLabelCache* cache, Clock::time_point t0, MultiLabelResult& r)
 {
   const GraphEdges& edges = *pr.Edges;
   r.Error = GraphSizeProblem(pr.Nodes, edges.Size()); // before the geodesic term's 32-bit ids
@@ -359,6 +359,21 @@ void SolveLabels(PottsProblem& pr, std::vector<std::int16_t> hard, const std::ve
       return;
     }
     r.GeodesicSeconds = Since(g0);
+  }
+  if (!reach.empty())
+  {
+    const int L = pr.Labels;
+    parallel(pr.Nodes, 16384, [&](std::int64_t p0, std::int64_t p1) {
+      for (std::int64_t p = p0; p < p1; ++p)
+      {
+        const double s = par.Lambda * (size.empty() ? 1.0 : size[p]);
+        for (int l = 1; l < L; ++l)
+        {
+          pr.Cost[p * L + l] += s * reach[p * (L - 1) + l - 1];
+        }
+      }
+    });
+    r.Reach = SharedArray<double>(std::move(reach));
   }
   r.Sigma = par.Sigma;
   if (cache && static_cast<std::int64_t>(cache->Weight.size()) == edges.Size())
@@ -862,8 +877,13 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
   }
   const bool weighted = cache && static_cast<std::int64_t>(cache->Weight.size()) == edges.Size();
   const SharedArray<double> contact = weighted ? SharedArray<double>() : MeshContact(mesh, data, par.ScaleByContact);
+  std::vector<double> reach;
+  if (par.Task == Task::Object)
+  {
+    SeedReachCosts(MeshCentres(mesh, data), seeds.Voxel, seeds.Label, L, par.Reach, parallel, reach);
+  }
   SolveLabels(pr, hard, mean, bins, step, contact.Vector(),
-    count, border, par, multi, std::move(start), parallel, progress, cache, t0, r);
+    count, border, par, multi, std::move(reach), std::move(start), parallel, progress, cache, t0, r);
   if (!r.Error.empty() || r.Aborted)
   {
     return r;
@@ -909,7 +929,13 @@ MultiLabelResult MultiLabelVoxelCut(const std::vector<double>& values, const Cha
       pr.Cost[v * L + l] = par.Lambda * costs[l][bins.Bin[v]];
     }
   }
-  SolveLabels(pr, hard, values, bins, {}, {}, {}, BorderVoxels(g), par, multi, {}, parallel, progress, nullptr, t0, r);
+  std::vector<double> reach;
+  if (par.Task == Task::Object)
+  {
+    SeedReachCosts(VoxelCentres(g), seeds.Voxel, seeds.Label, L, par.Reach, parallel, reach);
+  }
+  SolveLabels(pr, hard, values, bins, {}, {}, {}, BorderVoxels(g), par, multi, std::move(reach), {}, parallel, progress,
+    nullptr, t0, r);
   return r;
 }
 } // namespace featuremesh

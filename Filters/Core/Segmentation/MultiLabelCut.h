@@ -110,6 +110,9 @@ struct MultiLabelResult
   // as the expansion paid it (nodes x labels, lambda x size x the term per voxel; empty without one).
   std::vector<std::vector<double>> BinCosts;
   SharedArray<double> Spatial;
+  // The seeds' reach per voxel of each node (nodes x (labels - 1): the object labels; before
+  // lambda; empty without one).
+  SharedArray<double> Reach;
   std::string Error;
   bool Aborted = false;
 };

@@ -188,6 +188,28 @@ SharedArray<double> MeshCentreSteps(const SimplexMesh& mesh, const SuperVoxelCut
   return data.CentreSteps.size() == adj.A.size() ? data.CentreSteps : SharedArray<double>(CentreDistances(mesh, adj));
 }
 
+namespace
+{
+// The binary cut's reach term: the object seeds are label 1, the background seeds label 0.
+SharedArray<double> BinaryReach(const NodeCentres& nodes, const std::vector<std::int64_t>& objectVoxels,
+  const std::vector<std::int64_t>& backgroundVoxels, const SeedReachParameters& p, const ParallelFor& parallel)
+{
+  std::vector<std::int64_t> voxels(objectVoxels);
+  voxels.insert(voxels.end(), backgroundVoxels.begin(), backgroundVoxels.end());
+  std::vector<std::uint8_t> labels(objectVoxels.size(), 1);
+  labels.resize(voxels.size(), 0);
+  std::vector<double> object;
+  return SeedReachCosts(nodes, voxels, labels, 2, p, parallel, object) ? SharedArray<double>(std::move(object))
+                                                                       : SharedArray<double>();
+}
+} // namespace
+
+NodeCentres MeshCentres(const SimplexMesh& mesh, const SuperVoxelCutData& data)
+{
+  return data.Centres.Size() == mesh.NumberOfElements() && !data.Centres.Centre.empty() ? data.Centres
+                                                                                      : ElementCentres(mesh);
+}
+
 SharedArray<double> MeshContact(const SimplexMesh& mesh, const SuperVoxelCutData& data, bool scale)
 {
   return scale && data.Contact.size() == mesh.Faces().A.size() ? data.Contact
@@ -203,6 +225,7 @@ bool PrepareVoxelOwners(const SimplexMesh& mesh, SuperVoxelCutData& data, const 
   }
   data.CentreSteps = CentreDistances(mesh, mesh.Faces());
   data.Contact = ContactInVoxelFaces(mesh, true);
+  data.Centres = ElementCentres(mesh);
   return !data.Owner.empty();
 }
 
@@ -300,6 +323,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   {
     pr.Geodesic = parameters.Geodesic;
     pr.Step = MeshCentreSteps(mesh, data);
+    pr.Reach = BinaryReach(MeshCentres(mesh, data), objectVoxels, backgroundVoxels, parameters.Reach, parallel);
   }
   result.SetupSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
   result.Cut = BoykovJollyCut(pr, parameters, progress, flow);
@@ -432,6 +456,10 @@ std::string ValidateParameters(const SeededCutParameters& p)
   }
   if (error.empty())
   {
+    error = ValidateParameters(p.Reach);
+  }
+  if (error.empty())
+  {
     error = ValidateParameters(p.Geodesic);
   }
   return error;
@@ -487,6 +515,7 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
   if (parameters.Task == Task::Object)
   {
     pr.Geodesic = parameters.Geodesic;
+    pr.Reach = BinaryReach(VoxelCentres(g), objectVoxels, backgroundVoxels, parameters.Reach, parallel);
   }
   // Size and Contact stay empty: 1 for every voxel and every voxel face.
   CutResult cut = BoykovJollyCut(pr, parameters, SubProgress(progress, 0.1, 0.95));

@@ -7,6 +7,7 @@
 #include "ElementRasterizer.h"
 #include "Parallel.h"
 #include "SeedConnectivity.h"
+#include "SeedReach.h"
 #include "SimplexMesh.h"
 
 #include <algorithm>
@@ -43,6 +44,9 @@ struct SeededCutParameters : BoykovJollyParameters
   // The seeds' spatial term (SeedGeodesics.h), applied for Task Object: an object that looks like
   // the seeded one elsewhere is not the one asked for. Task Class has none.
   SeedGeodesicParameters Geodesic;
+  // The seeds' reach (SeedReach.h), for Task Object too: the object stays within reach of its
+  // seeds, where the geodesic term fades (docs/cut.md).
+  SeedReachParameters Reach;
   // Radius (voxels) of the neighbourhood of each seed whose voxels build the histograms.
   double SeedRadius = 2.0;
   // What the cut reads at each voxel, and the Gaussian scale (voxels) of the local contrast's
@@ -131,6 +135,8 @@ struct SuperVoxelCutData
   SharedArray<double> CentreSteps;
   // ContactInVoxelFaces of the mesh, scaled (made by PrepareVoxelOwners), shared the same way.
   SharedArray<double> Contact;
+  // The elements' centroids in frame coordinates, for the seeds' reach (made by PrepareVoxelOwners).
+  NodeCentres Centres;
   bool HasVoxelValues() const { return !this->Voxels.Empty(); }
 };
 
@@ -138,6 +144,7 @@ struct SuperVoxelCutData
 // without them): what both cuts put in their problems.
 SharedArray<double> MeshCentreSteps(const SimplexMesh& mesh, const SuperVoxelCutData& data);
 SharedArray<double> MeshContact(const SimplexMesh& mesh, const SuperVoxelCutData& data, bool scale);
+NodeCentres MeshCentres(const SimplexMesh& mesh, const SuperVoxelCutData& data);
 
 // The element owning each voxel into `data.Owner`, by rasterising the mesh unless it already holds
 // them (stage 2's, say). False when progress asked to abort.
