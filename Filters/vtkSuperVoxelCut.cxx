@@ -252,8 +252,8 @@ void vtkSuperVoxelCut::WriteCutFields(
   for (vtkDataObject* d : { vtkDataObject::GetData(outputVector, 0), vtkDataObject::GetData(outputVector, 2) })
   {
     AddFieldValues(d, { { names::Sigma, cut.Sigma }, { names::Bins, cut.Bins }, { names::SeedOverlap, cut.SeedOverlap },
-                        { names::SpatialWeight, cut.SpatialWeight }, { names::Flow, cut.Flow },
-                        { names::ObjectElements, static_cast<double>(objectElements) } });
+                        { names::SpatialWeight, cut.SpatialWeight }, { names::SeedReachDistance, cut.ReachDistance },
+                        { names::Flow, cut.Flow }, { names::ObjectElements, static_cast<double>(objectElements) } });
     AddObjectComponents(d, cut.ObjectComponentVoxels, voxelVolume, cut.ConnectivityChanged);
     AddFieldValues(d, { { names::SetupSeconds, result.SetupSeconds },
                         { names::OwnerMapReused, this->Prepared->OwnerMapReused ? 1.0 : 0.0 },

@@ -123,7 +123,8 @@ int vtkVoxelCut::RequestData(vtkInformation*, vtkInformationVector** inputVector
     }
     SetLabelImage(output, geometry, cut.Label);
     AddFieldValues(output, { { names::Sigma, cut.Sigma }, { names::Bins, cut.Bins }, { names::SeedOverlap, cut.SeedOverlap },
-                             { names::SpatialWeight, cut.SpatialWeight }, { names::Flow, cut.Flow },
+                             { names::SpatialWeight, cut.SpatialWeight },
+                             { names::SeedReachDistance, cut.ReachDistance }, { names::Flow, cut.Flow },
                              { names::GraphSeconds, cut.GraphSeconds }, { names::FlowSeconds, cut.FlowSeconds },
                              { names::GeodesicSeconds, cut.GeodesicSeconds } });
     AddObjectComponents(output, cut.ObjectComponentVoxels, geometry.VoxelVolume(), cut.ConnectivityChanged);

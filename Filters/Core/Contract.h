@@ -122,6 +122,7 @@ constexpr const char* Sigma = "Sigma";
 constexpr const char* Bins = "Bins";
 constexpr const char* SeedOverlap = "SeedOverlap";     // the seeds' densities' Bhattacharyya coefficient (binary cut)
 constexpr const char* SpatialWeight = "SpatialWeight"; // the geodesic weight a binary cut used (0: none)
+constexpr const char* SeedReachDistance = "SeedReachDistance"; // R of the seeds' reach, world units (binary cut; 0: none)
 constexpr const char* Flow = "Flow";
 constexpr const char* ObjectElements = "ObjectElements";
 constexpr const char* ObjectComponents = "ObjectComponents";

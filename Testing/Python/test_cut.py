@@ -144,6 +144,14 @@ overlap, used = (fields.GetArray(n).GetValue(0) for n in (ft.names.SeedOverlap, 
 weight = float(cut.GeodesicWeight)
 ft.check(0.0 < overlap < 1.0 and abs(used - weight * overlap / 0.75) <= 1e-9 * weight,
          "liver: adaptive geodesic weight %.3f = %.2f x overlap %.3f / 0.75" % (used, weight, overlap))
+# The seeds' reach: R, the largest distance from an object seed's voxel to its nearest background
+# seed's voxel, as the field data reports it.
+grid = ft.fetch(image)
+at = {k: ft.np.array([[round((ft.fetch(s).GetPoint(i)[a] - grid.GetOrigin()[a]) / grid.GetSpacing()[a]) * grid.GetSpacing()[a]
+                       for a in range(3)] for i in range(ft.fetch(s).GetNumberOfPoints())]) for k, s in (("o", so), ("b", sb))}
+want = max(ft.np.linalg.norm(at["b"] - o, axis=1).min() for o in at["o"])
+reach = fields.GetArray(ft.names.SeedReachDistance).GetValue(0)
+ft.check(abs(reach - want) <= 1e-9 * want and want > 0, "liver: the seeds' reach R %.2f mm (%.2f from the seed files)" % (reach, want))
 fixed = ft.SuperVoxelCut(Mesh=cut.Mesh, ObjectSeeds=so, BackgroundSeeds=sb, Image=image, AdaptiveGeodesicWeight=0)
 fixed.UpdatePipeline()
 fixed_used = ft.fetch(fixed, 2).GetFieldData().GetArray(ft.names.SpatialWeight).GetValue(0)

@@ -154,6 +154,8 @@ struct CutResult
   // The seed densities' overlap (Bhattacharyya coefficient) and the spatial term's weight this cut
   // used; SpatialObject / SpatialBackground are at Geodesic.Weight, and SpatialScale takes them to it.
   double SeedOverlap = 0.0, SpatialWeight = 0.0, SpatialScale = 1.0;
+  // R of the seeds' reach (SeedReach.h) in frame units, set by the cuts that add it; 0 without one.
+  double ReachDistance = 0.0;
   std::string Error;
   bool Aborted = false;
 };

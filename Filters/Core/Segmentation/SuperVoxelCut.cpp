@@ -192,15 +192,17 @@ namespace
 {
 // The binary cut's reach term: the object seeds are label 1, the background seeds label 0.
 SharedArray<double> BinaryReach(const NodeCentres& nodes, const std::vector<std::int64_t>& objectVoxels,
-  const std::vector<std::int64_t>& backgroundVoxels, const SeedReachParameters& p, const ParallelFor& parallel)
+  const std::vector<std::int64_t>& backgroundVoxels, const SeedReachParameters& p, const ParallelFor& parallel,
+  double& distance)
 {
   std::vector<std::int64_t> voxels(objectVoxels);
   voxels.insert(voxels.end(), backgroundVoxels.begin(), backgroundVoxels.end());
   std::vector<std::uint8_t> labels(objectVoxels.size(), 1);
   labels.resize(voxels.size(), 0);
-  std::vector<double> object;
-  return SeedReachCosts(nodes, voxels, labels, 2, p, parallel, object) ? SharedArray<double>(std::move(object))
-                                                                       : SharedArray<double>();
+  std::vector<double> object, reach;
+  const bool any = SeedReachCosts(nodes, voxels, labels, 2, p, parallel, object, &reach);
+  distance = any ? reach[1] : 0.0;
+  return any ? SharedArray<double>(std::move(object)) : SharedArray<double>();
 }
 } // namespace
 
@@ -248,6 +250,7 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   }
 
   CutProblem pr;
+  double reach = 0.0;
   pr.Hard.assign(m, 0);
   if (!SeedConstraints(owner, objectVoxels, backgroundVoxels, "element", pr.Hard, result.Error))
   {
@@ -323,10 +326,11 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   {
     pr.Geodesic = parameters.Geodesic;
     pr.Step = MeshCentreSteps(mesh, data);
-    pr.Reach = BinaryReach(MeshCentres(mesh, data), objectVoxels, backgroundVoxels, parameters.Reach, parallel);
+    pr.Reach = BinaryReach(MeshCentres(mesh, data), objectVoxels, backgroundVoxels, parameters.Reach, parallel, reach);
   }
   result.SetupSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
   result.Cut = BoykovJollyCut(pr, parameters, progress, flow);
+  result.Cut.ReachDistance = reach;
   result.Aborted = result.Cut.Aborted;
   if (!result.Cut.Error.empty() || result.Aborted)
   {
@@ -485,6 +489,7 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
 {
   CutResult failed;
   const std::int64_t n = g.Size();
+  double reach = 0.0;
   CutProblem pr;
   pr.Parallel = parallel;
   pr.Value = std::move(values);
@@ -515,10 +520,11 @@ CutResult VoxelCut(std::vector<double> values, const ImageGeometry& g,
   if (parameters.Task == Task::Object)
   {
     pr.Geodesic = parameters.Geodesic;
-    pr.Reach = BinaryReach(VoxelCentres(g), objectVoxels, backgroundVoxels, parameters.Reach, parallel);
+    pr.Reach = BinaryReach(VoxelCentres(g), objectVoxels, backgroundVoxels, parameters.Reach, parallel, reach);
   }
   // Size and Contact stay empty: 1 for every voxel and every voxel face.
   CutResult cut = BoykovJollyCut(pr, parameters, SubProgress(progress, 0.1, 0.95));
+  cut.ReachDistance = reach;
   if (!cut.Error.empty() || cut.Aborted || !progress(0.95))
   {
     cut.Aborted = cut.Error.empty();
