@@ -205,7 +205,6 @@ std::vector<std::int64_t> ThinEdgePoints(
   // count as ceil(|d| / m) (ImageGeometry::MedianVoxelFactors), so that kept points are not denser
   // across thin slices, which left flat tetrahedra stage 3 could not mend (docs/smoothing.md).
   const std::array<int, 3> m = g.MedianVoxelFactors();
-  auto along = [&m](int a, int d) { return (std::abs(d) + m[a] - 1) / m[a]; };
 
   // Small radii (all the defaults): a map of the Chebyshev distance to the nearest kept point,
   // capped past the largest radius, stamped around each kept point. A point is blocked exactly when
@@ -218,6 +217,16 @@ std::vector<std::int64_t> ThinEdgePoints(
     std::vector<std::uint8_t> distance(static_cast<std::size_t>(g.Size()), far);
     std::vector<std::int64_t> kept;
     const int ir = largest * m[0], jr = largest * m[1], kr = g.Is2D() ? 0 : largest * m[2];
+    // Each axis's offsets -r..r as distances: the stamp's inner loop looks them up.
+    auto distances = [&m](int a, int r) {
+      std::vector<int> d(2 * r + 1);
+      for (int o = -r; o <= r; ++o)
+      {
+        d[o + r] = (std::abs(o) + m[a] - 1) / m[a];
+      }
+      return d;
+    };
+    const std::vector<int> alongI = distances(0, ir), alongJ = distances(1, jr), alongK = distances(2, kr);
     for (std::int64_t t : order)
     {
       if (distance[pts[t]] <= radii[t])
@@ -232,10 +241,10 @@ std::vector<std::int64_t> ThinEdgePoints(
         for (int dj = std::max(-jr, -j); dj <= std::min(jr, g.Dims[1] - 1 - j); ++dj)
         {
           std::uint8_t* row = distance.data() + g.Index(0, j + dj, k + dk);
-          const int dkj = std::max(along(2, dk), along(1, dj));
+          const int dkj = std::max(alongK[dk + kr], alongJ[dj + jr]);
           for (int di = std::max(-ir, -i); di <= std::min(ir, g.Dims[0] - 1 - i); ++di)
           {
-            const std::uint8_t d = static_cast<std::uint8_t>(std::max(dkj, along(0, di)));
+            const std::uint8_t d = static_cast<std::uint8_t>(std::max(dkj, alongI[di + ir]));
             row[i + di] = std::min(row[i + di], d);
           }
         }

@@ -1152,11 +1152,8 @@ CutResult BoykovJollyCut(const CutProblem& pr, const BoykovJollyParameters& par,
   if (aborted(RegionCosts(pr, bin, costs, low, width, cache ? &cache->Binned : nullptr, regionObject.get(),
         regionBackground.get(), SubProgress(progress, 0.2, 0.3))) ||
     aborted(SeedGeodesicTerm(pr, lattice.HistogramHigh() - lattice.HistogramLow(), cache ? &cache->Geodesic : nullptr,
-      spatialObject, spatialBackground, SubProgress(progress, 0.3, 0.33), r.GeodesicSeconds)))
-  {
-    return r;
-  }
-  if (aborted(ScaleRegionCosts(pr, spatialObject, spatialBackground, par.Lambda, n, regionObject.get(), regionBackground.get(),
+      spatialObject, spatialBackground, SubProgress(progress, 0.3, 0.33), r.GeodesicSeconds)) ||
+    aborted(ScaleRegionCosts(pr, spatialObject, spatialBackground, par.Lambda, n, regionObject.get(), regionBackground.get(),
       total, SubProgress(progress, 0.33, 0.35), r.SpatialScale)) ||
     aborted(progress(0.35)))
   {

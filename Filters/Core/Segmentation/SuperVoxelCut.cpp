@@ -208,8 +208,8 @@ SharedArray<double> BinaryReach(const NodeCentres& nodes, const std::vector<std:
 
 NodeCentres MeshCentres(const SimplexMesh& mesh, const SuperVoxelCutData& data)
 {
-  return data.Centres.Size() == mesh.NumberOfElements() && !data.Centres.Centre.empty() ? data.Centres
-                                                                                      : ElementCentres(mesh);
+  return static_cast<std::int64_t>(data.Centres.Centre.size()) == mesh.NumberOfElements() ? data.Centres
+                                                                                           : ElementCentres(mesh);
 }
 
 SharedArray<double> MeshContact(const SimplexMesh& mesh, const SuperVoxelCutData& data, bool scale)
