@@ -310,14 +310,17 @@ std::int64_t DelaunayFlips(const ImageGeometry& g, const std::vector<V3>& indexP
 constexpr double BoxSnapVoxels = 1.5;
 
 // Moves the nodes within BoxSnapVoxels of box faces onto them (index space; near two faces, onto
-// their edge), unless a box node already lies within a quarter voxel of where it would land. Returns
-// how many moved.
+// their edge), unless a box node already lies within a quarter voxel of where it would land. Along
+// an axis thinner than the other two both distances are in its median-axis voxels (m of its own),
+// as Feature Nodes spaces its nodes there. Returns how many moved.
 std::int64_t SnapNodesToBox(const ImageGeometry& g, std::vector<V3>& points)
 {
-  // Box nodes by voxel, for the quarter-voxel test.
+  const std::array<int, 3> m = g.MedianVoxelFactors();
+  // Box nodes by median-axis voxel, for the quarter-voxel test.
   std::map<std::array<std::int64_t, 3>, std::vector<V3>> boxNodes;
-  auto voxel = [](const V3& q) {
-    return std::array<std::int64_t, 3>{ { std::llround(q[0]), std::llround(q[1]), std::llround(q[2]) } };
+  auto voxel = [&](const V3& q) {
+    return std::array<std::int64_t, 3>{ { std::llround(q[0] / m[0]), std::llround(q[1] / m[1]),
+      std::llround(q[2] / m[2]) } };
   };
   auto onBox = [&](const V3& q) {
     for (int a = 0; a < 3; ++a)
@@ -351,7 +354,8 @@ std::int64_t SnapNodesToBox(const ImageGeometry& g, std::vector<V3>& points)
           }
           for (const V3& q : it->second)
           {
-            if (std::fabs(q[0] - to[0]) < 0.25 && std::fabs(q[1] - to[1]) < 0.25 && std::fabs(q[2] - to[2]) < 0.25)
+            if (std::fabs(q[0] - to[0]) < 0.25 * m[0] && std::fabs(q[1] - to[1]) < 0.25 * m[1] &&
+              std::fabs(q[2] - to[2]) < 0.25 * m[2])
             {
               return true;
             }
@@ -371,12 +375,12 @@ std::int64_t SnapNodesToBox(const ImageGeometry& g, std::vector<V3>& points)
     V3 to = q;
     for (int a = 0; a < 3; ++a)
     {
-      const double last = g.Dims[a] - 1.0;
-      if (g.Dims[a] > 1 && to[a] <= BoxSnapVoxels)
+      const double last = g.Dims[a] - 1.0, snap = BoxSnapVoxels * m[a];
+      if (g.Dims[a] > 1 && to[a] <= snap)
       {
         to[a] = 0.0;
       }
-      else if (g.Dims[a] > 1 && last - to[a] <= BoxSnapVoxels)
+      else if (g.Dims[a] > 1 && last - to[a] <= snap)
       {
         to[a] = last;
       }
