@@ -186,6 +186,53 @@ TEST(Halftone, CountFallsAsThresholdRises)
   }
 }
 
+// Slices thinner than the pixel: the dots are those of the median-axis grid (runs of m voxels as
+// one cell of their mean), each at its run's largest value, so a constant map gives as many dots
+// per mm^3 as on cubic voxels instead of m times as many.
+TEST(Halftone, ThinSlicesHaveTheDotsOfTheMedianAxisGrid)
+{
+  ImageGeometry g;
+  g.Dims = { { 24, 20, 41 } }; // an odd slice count: the last run is one voxel
+  g.Spacing = { { 1.0, 1.0, 0.5 } };
+  ASSERT_EQ(g.MedianVoxelFactors(), (std::array<int, 3>{ { 1, 1, 2 } }));
+  ImageGeometry cells = g;
+  cells.Dims[2] = 21;
+  cells.Spacing[2] = 1.0;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.f, 0.6f);
+  std::vector<float> rho(g.Size());
+  for (float& r : rho)
+    r = u(rng);
+  std::vector<float> mean(cells.Size());
+  std::vector<std::int64_t> peak(cells.Size());
+  for (int k = 0; k < cells.Dims[2]; ++k)
+    for (int j = 0; j < g.Dims[1]; ++j)
+      for (int i = 0; i < g.Dims[0]; ++i)
+      {
+        const std::int64_t a = g.Index(i, j, 2 * k), c = cells.Index(i, j, k);
+        const bool pair = 2 * k + 1 < g.Dims[2];
+        const std::int64_t b = pair ? g.Index(i, j, 2 * k + 1) : a;
+        mean[c] = pair ? (rho[a] + rho[b]) / 2.f : rho[a];
+        peak[c] = rho[b] > rho[a] ? b : a;
+      }
+  for (double q : { 0.3, 0.5 })
+  {
+    std::vector<std::int64_t> want;
+    for (std::int64_t d : Halftone(mean.data(), cells, q))
+      want.push_back(peak[d]);
+    std::sort(want.begin(), want.end());
+    EXPECT_EQ(HalftoneInMedianVoxels(rho.data(), g, q), want) << "q = " << q;
+  }
+  const std::vector<float> flat(g.Size(), 0.25f), flatCells(cells.Size(), 0.25f);
+  const std::size_t thin = HalftoneInMedianVoxels(flat.data(), g, 0.3).size();
+  EXPECT_EQ(thin, Halftone(flatCells.data(), cells, 0.3).size());
+  EXPECT_GT(Halftone(flat.data(), g, 0.3).size(), 3 * thin / 2) << "the voxel grid's dots are denser across thin slices";
+  // Cubic voxels keep the voxel grid's dots.
+  ImageGeometry cubic = g;
+  cubic.Spacing[2] = 1.0;
+  EXPECT_EQ(HalftoneInMedianVoxels(rho.data(), cubic, 0.3), Halftone(rho.data(), cubic, 0.3));
+}
+
 TEST(Hessian, LargestAbsEigenvalueMatchesEigen)
 {
   // Random symmetric matrices plus the degenerate cases of the closed form: zero, multiples of

@@ -398,8 +398,10 @@ bool PlaceHalftoneNodes(const float* image, float* f, float* work, const ImageGe
   }
   t0 = Clock::now();
   const int h = p.ExclusionWindow / 2;
-  const std::array<int, 3> box{ { h, h, h } }; // in voxels on every axis, as the halftone's density
-  for (std::int64_t d : Halftone(rho, g, p.HalftoneThreshold))
+  // In voxels on every axis: in median-axis voxels along a thin axis it kept fewer points near the
+  // edges and lowered the oracle Dice of the liver with halved slices (0.931 -> 0.925).
+  const std::array<int, 3> box{ { h, h, h } };
+  for (std::int64_t d : HalftoneInMedianVoxels(rho, g, p.HalftoneThreshold))
   {
     int i, j, k;
     Coordinates(g, d, i, j, k);

@@ -3,19 +3,25 @@
 #include "ImagingInternals.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
 namespace featuremesh
 {
 using namespace detail;
-std::vector<std::int64_t> Halftone(const float* rho, const ImageGeometry& g, double q)
+namespace
+{
+// Error diffusion over a grid of Dims cells (2D when the third is 1) whose rows come from row(j, k),
+// a pointer to the row's Dims[0] values; returns the cells with dots, in order.
+template <typename Row>
+std::vector<std::int64_t> Diffuse(const std::array<int, 3>& dims, double q, Row&& row)
 {
   std::vector<std::int64_t> dots;
-  const int nx = g.Dims[0], ny = g.Dims[1], nz = g.Dims[2];
+  const int nx = dims[0], ny = dims[1], nz = dims[2];
   const float threshold = static_cast<float>(q);
   const float dot = static_cast<float>(2.0 * q);
-  const bool is2D = g.Is2D();
+  const bool is2D = nz == 1;
   // Error buffers: current slice and next slice, so memory stays two slices, not the volume. They
   // carry a one-cell margin all round: error pushed off the image lands there and is never read,
   // so the inner loop needs no bounds checks (the sums in the image cells are unchanged).
@@ -26,13 +32,13 @@ std::vector<std::int64_t> Halftone(const float* rho, const ImageGeometry& g, dou
   const float right = w * (7.f / 16.f), downLeft = w * (3.f / 16.f), down = w * (5.f / 16.f),
               downRight = w * (1.f / 16.f);
   const bool toNextSlice = !is2D;
-  const std::int64_t slice = g.SliceStride();
+  const std::int64_t slice = static_cast<std::int64_t>(nx) * ny;
   for (int k = 0; k < nz; ++k)
   {
     const bool carry = toNextSlice && k + 1 < nz;
     for (int j = 0; j < ny; ++j)
     {
-      const float* in = rho + k * slice + static_cast<std::int64_t>(j) * nx;
+      const float* in = row(j, k);
       float* c = cur.data() + (j + 1) * pitch + 1;
       float* z = carry ? nxt.data() + (j + 1) * pitch + 1 : nullptr;
       // The error pushed to the right neighbour stays in a register: added last, as it would be
@@ -78,6 +84,72 @@ std::vector<std::int64_t> Halftone(const float* rho, const ImageGeometry& g, dou
       std::fill(nxt.begin(), nxt.end(), 0.f);
     }
   }
+  return dots;
+}
+} // namespace
+
+std::vector<std::int64_t> Halftone(const float* rho, const ImageGeometry& g, double q)
+{
+  const std::int64_t slice = g.SliceStride();
+  return Diffuse(g.Dims, q, [&](int j, int k) { return rho + k * slice + static_cast<std::int64_t>(j) * g.Dims[0]; });
+}
+
+std::vector<std::int64_t> HalftoneInMedianVoxels(const float* rho, const ImageGeometry& g, double q)
+{
+  const std::array<int, 3> m = g.MedianVoxelFactors();
+  if (m[0] * m[1] * m[2] == 1)
+  {
+    return Halftone(rho, g, q);
+  }
+  std::array<int, 3> cells;
+  for (int a = 0; a < 3; ++a)
+  {
+    cells[a] = (g.Dims[a] + m[a] - 1) / m[a];
+  }
+  // A cell's voxels: [c m, min((c + 1) m, Dims)) on each axis.
+  const auto run = [&](int a, int c) { return std::array<int, 2>{ { c * m[a], std::min((c + 1) * m[a], g.Dims[a]) } }; };
+  std::vector<float> means(cells[0]);
+  std::vector<std::int64_t> dots = Diffuse(cells, q, [&](int cj, int ck) {
+    const auto [j0, j1] = run(1, cj);
+    const auto [k0, k1] = run(2, ck);
+    for (int ci = 0; ci < cells[0]; ++ci)
+    {
+      const auto [i0, i1] = run(0, ci);
+      double sum = 0.0;
+      for (int k = k0; k < k1; ++k)
+      {
+        for (int j = j0; j < j1; ++j)
+        {
+          for (int i = i0; i < i1; ++i)
+          {
+            sum += rho[g.Index(i, j, k)];
+          }
+        }
+      }
+      means[ci] = static_cast<float>(sum / ((i1 - i0) * (j1 - j0) * (k1 - k0)));
+    }
+    return means.data();
+  });
+  const std::int64_t cellSlice = static_cast<std::int64_t>(cells[0]) * cells[1];
+  for (std::int64_t& d : dots)
+  {
+    const int ck = static_cast<int>(d / cellSlice), cj = static_cast<int>(d % cellSlice / cells[0]),
+              ci = static_cast<int>(d % cells[0]);
+    std::int64_t peak = -1;
+    for (int k = run(2, ck)[0]; k < run(2, ck)[1]; ++k)
+    {
+      for (int j = run(1, cj)[0]; j < run(1, cj)[1]; ++j)
+      {
+        for (int i = run(0, ci)[0]; i < run(0, ci)[1]; ++i)
+        {
+          const std::int64_t v = g.Index(i, j, k);
+          peak = peak < 0 || rho[v] > rho[peak] ? v : peak;
+        }
+      }
+    }
+    d = peak;
+  }
+  std::sort(dots.begin(), dots.end());
   return dots;
 }
 } // namespace featuremesh
