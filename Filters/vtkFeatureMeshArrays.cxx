@@ -349,6 +349,14 @@ void AddMultiLabelFields(vtkDataObject* object, const MultiLabelResult& result, 
   AddFieldValue(object, names::ExpansionCycles, result.Cycles);
   AddFieldValue(object, names::ExpansionSeconds, result.ExpansionSeconds);
   AddFieldValue(object, names::GeodesicSeconds, result.GeodesicSeconds);
+  vtkNew<vtkDoubleArray> reach;
+  reach->SetName(names::SeedReachDistance);
+  reach->SetNumberOfTuples(result.Labels);
+  for (int l = 0; l < result.Labels; ++l)
+  {
+    reach->SetValue(l, l < static_cast<int>(result.ReachDistance.size()) ? result.ReachDistance[l] : 0.0);
+  }
+  object->GetFieldData()->AddArray(reach);
 }
 
 void SetLabelImage(vtkImageData* image, const ImageGeometry& geometry, const std::vector<std::uint8_t>& labels)

@@ -122,7 +122,8 @@ constexpr const char* Sigma = "Sigma";
 constexpr const char* Bins = "Bins";
 constexpr const char* SeedOverlap = "SeedOverlap";     // the seeds' densities' Bhattacharyya coefficient (binary cut)
 constexpr const char* SpatialWeight = "SpatialWeight"; // the geodesic weight a binary cut used (0: none)
-constexpr const char* SeedReachDistance = "SeedReachDistance"; // R of the seeds' reach, world units (binary cut; 0: none)
+// R of the seeds' reach, world units (0: none); with labelled seeds one value per label.
+constexpr const char* SeedReachDistance = "SeedReachDistance";
 constexpr const char* Flow = "Flow";
 constexpr const char* ObjectElements = "ObjectElements";
 constexpr const char* ObjectComponents = "ObjectComponents";

@@ -42,6 +42,17 @@ for name, folder in cases.items():
     field = ft.fetch(cut, 2).GetFieldData()
     ft.check(field.GetArray(ft.names.Labels).GetValue(0) == k + 1, "%s: %d labels" % (name, k + 1))
     ft.check(field.GetAbstractArray(ft.names.LabelNames).GetComponentName(1) == case.names[1], "%s: label 1 is named %s" % (name, case.names[1]))
+    # The seeds' reach per label: R, the largest distance from one of its seeds' voxels to the nearest
+    # background seed's voxel (0 for the background).
+    at = {}
+    for x, y, z, label in case.seed_rows():
+        ijk = [0.0, 0.0, 0.0]
+        image.TransformPhysicalPointToContinuousIndex([x, y, z], ijk)
+        at.setdefault(label, []).append(np.floor(np.array(ijk) + 0.5) * image.GetSpacing())
+    want = [0.0] + [max(np.linalg.norm(np.array(at[0]) - s, axis=1).min() for s in at[l]) for l in range(1, k + 1)]
+    got = ft.v2n(field.GetArray(ft.names.SeedReachDistance))
+    ft.check(len(got) == k + 1 and np.allclose(got, want, rtol=1e-9) and min(want[1:]) > 0,
+             "%s: the seeds' reach R per label %s mm (%s from the seeds)" % (name, np.round(got, 2), np.round(want, 2)))
     if name != "abdomen-ct-totalseg":
         continue
 

@@ -880,7 +880,7 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
   std::vector<double> reach;
   if (par.Task == Task::Object)
   {
-    SeedReachCosts(MeshCentres(mesh, data), seeds.Voxel, seeds.Label, L, par.Reach, parallel, reach);
+    SeedReachCosts(MeshCentres(mesh, data), seeds.Voxel, seeds.Label, L, par.Reach, parallel, reach, &r.ReachDistance);
   }
   SolveLabels(pr, hard, mean, bins, step, contact.Vector(),
     count, border, par, multi, std::move(reach), std::move(start), parallel, progress, cache, t0, r);
@@ -932,7 +932,7 @@ MultiLabelResult MultiLabelVoxelCut(const std::vector<double>& values, const Cha
   std::vector<double> reach;
   if (par.Task == Task::Object)
   {
-    SeedReachCosts(VoxelCentres(g), seeds.Voxel, seeds.Label, L, par.Reach, parallel, reach);
+    SeedReachCosts(VoxelCentres(g), seeds.Voxel, seeds.Label, L, par.Reach, parallel, reach, &r.ReachDistance);
   }
   SolveLabels(pr, hard, values, bins, {}, {}, {}, BorderVoxels(g), par, multi, std::move(reach), {}, parallel, progress,
     nullptr, t0, r);

@@ -113,6 +113,8 @@ struct MultiLabelResult
   // The seeds' reach per voxel of each node (nodes x (labels - 1): the object labels; before
   // lambda; empty without one).
   SharedArray<double> Reach;
+  // R of each label's reach, world units (label 0 and labels without the term: 0).
+  std::vector<double> ReachDistance;
   std::string Error;
   bool Aborted = false;
 };
