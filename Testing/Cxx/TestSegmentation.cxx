@@ -736,6 +736,101 @@ TEST(SeedConnectivity, ComponentsAreNumberedInNodeOrder)
   EXPECT_EQ(ObjectComponentSizes(label, GraphEdges(A, B), { 1, 2, 4, 8, 16, 32 }), (std::vector<double>{ 8, 3 }));
 }
 
+TEST(SeedConnectivity, ContactsJoinComponentsOfOneLabel)
+{
+  // A chain 0-1-2-3-4 with labels 1 0 1 0 1; object seed on node 0, background seed on node 3.
+  // Node 2 is a piece of its own along the edges; a contact 0-2 (their voxels touch) joins it to the
+  // seeded piece, so Seeded Object keeps it, and node 1 (no seed, off the border) becomes a hole
+  // that is filled; node 4 stays unseeded and is dropped.
+  const std::vector<std::int64_t> A = { 0, 1, 2, 3 }, B = { 1, 2, 3, 4 };
+  const std::vector<std::int64_t> CA = { 0, 1 }, CB = { 2, 4 }; // 1-4: labels differ, no join
+  const std::vector<std::uint8_t> hard = { 1, 0, 0, 2, 0 }, border(5, 0);
+  std::vector<std::uint8_t> label = { 1, 0, 1, 0, 1 };
+  std::int64_t count = 0;
+  std::vector<std::int64_t> id = LabelComponents(label, GraphEdges(A, B), count);
+  ASSERT_EQ(count, 5);
+  JoinContacts(label, GraphEdges(CA, CB), id, count);
+  EXPECT_EQ(count, 4);
+  EXPECT_EQ(id, (std::vector<std::int64_t>{ 0, 1, 0, 2, 3 }));
+  std::vector<std::uint8_t> without = label;
+  ApplyConnectivity(Connectivity::SeededObject, without, GraphEdges(A, B), hard, border);
+  EXPECT_EQ(without, (std::vector<std::uint8_t>{ 1, 0, 0, 0, 0 }));
+  std::vector<double> sizes;
+  ApplyConnectivity(Connectivity::SeededObject, label, GraphEdges(A, B), hard, border, NoProgress(), &sizes, {}, nullptr,
+    GraphEdges(CA, CB));
+  EXPECT_EQ(label, (std::vector<std::uint8_t>{ 1, 1, 1, 0, 0 }));
+  EXPECT_EQ(sizes, (std::vector<double>{ 3 })); // one object component
+  // ApplyWithContacts asks only for the contacts of the nodes the rule relabels (2 and 4, then 1
+  // too) and reaches the same labels.
+  std::vector<std::uint8_t> lazy = { 1, 0, 1, 0, 1 };
+  std::vector<std::vector<std::int64_t>> asked;
+  const ContactsFunction contactsOf = [&](const std::vector<std::int64_t>& nodes) {
+    asked.push_back(nodes);
+    std::vector<std::int64_t> a, b;
+    for (std::size_t c = 0; c < CA.size(); ++c)
+      if (std::binary_search(nodes.begin(), nodes.end(), CA[c]) || std::binary_search(nodes.begin(), nodes.end(), CB[c]))
+      {
+        a.push_back(CA[c]);
+        b.push_back(CB[c]);
+      }
+    return GraphEdges::Owned(a, b);
+  };
+  ApplyWithContacts(lazy, contactsOf, [&](std::vector<std::uint8_t>& l, const GraphEdges& contacts) {
+    return ApplyConnectivity(Connectivity::SeededObject, l, GraphEdges(A, B), hard, border, NoProgress(), nullptr, {}, nullptr, contacts);
+  });
+  EXPECT_EQ(lazy, label);
+  EXPECT_EQ(asked, (std::vector<std::vector<std::int64_t>>{ { 2, 4 }, { 1, 2, 4 } }));
+}
+
+TEST(SuperVoxelCut, VoxelContactsAreTheVoxelFacesTheMeshFacesMiss)
+{
+  // Random Delaunay meshes of a 2D and a 3D grid: the contacts of a set of elements are exactly the
+  // element pairs, one of them in the set, of face-adjacent voxels that share no mesh face, ascending.
+  for (const int depth : { 1, 14 })
+  {
+    ImageGeometry g;
+    g.Dims = { { 30, 26, depth } };
+    std::mt19937 rng(19);
+    std::vector<std::array<double, 3>> pts;
+    for (int n = 0; n < (depth == 1 ? 120 : 400); ++n)
+      pts.push_back({ { std::uniform_real_distribution<double>(0.0, 29.0)(rng), std::uniform_real_distribution<double>(0.0, 25.0)(rng),
+        depth == 1 ? 0.0 : std::uniform_real_distribution<double>(0.0, depth - 1.0)(rng) } });
+    for (int c = 0; c < (depth == 1 ? 4 : 8); ++c)
+      pts.push_back({ { (c & 1) ? 29.0 : 0.0, (c & 2) ? 25.0 : 0.0, (c & 4) ? depth - 1.0 : 0.0 } });
+    SimplexMesh mesh;
+    ASSERT_TRUE(CGALMeshOfNodes(g, pts, mesh));
+    SuperVoxelCutData data;
+    ASSERT_TRUE(PrepareVoxelOwners(mesh, data, SerialFor()));
+    std::set<std::pair<std::int64_t, std::int64_t>> faces;
+    for (std::size_t f = 0; f < mesh.Faces().A.size(); ++f)
+      faces.insert({ mesh.Faces().A[f], mesh.Faces().B[f] });
+    for (const int every : { 1, 3 })
+    {
+      std::vector<std::int64_t> elements;
+      for (std::int64_t e = 0; e < mesh.NumberOfElements(); e += every)
+        elements.push_back(e);
+      std::set<std::pair<std::int64_t, std::int64_t>> want;
+      for (int k = 0; k < g.Dims[2]; ++k)
+        for (int j = 0; j < g.Dims[1]; ++j)
+          for (int i = 0; i < g.Dims[0]; ++i)
+            for (const std::array<int, 3> d : { std::array<int, 3>{ { 1, 0, 0 } }, { { 0, 1, 0 } }, { { 0, 0, 1 } } })
+            {
+              if (!g.Contains(i + d[0], j + d[1], k + d[2]))
+                continue;
+              const std::int64_t a = data.Owner[g.Index(i, j, k)], b = data.Owner[g.Index(i + d[0], j + d[1], k + d[2])];
+              const std::pair<std::int64_t, std::int64_t> ab{ std::min(a, b), std::max(a, b) };
+              if (a >= 0 && b >= 0 && a != b && !faces.count(ab) && (a % every == 0 || b % every == 0))
+                want.insert(ab);
+            }
+      EXPECT_FALSE(want.empty()) << "depth " << depth; // elements meeting at a vertex or an edge
+      std::vector<std::pair<std::int64_t, std::int64_t>> got;
+      VoxelContactsOf(mesh, data.Owner, elements).ForEach([&](std::int64_t, std::int64_t a, std::int64_t b) { got.push_back({ a, b }); });
+      const std::vector<std::pair<std::int64_t, std::int64_t>> expected(want.begin(), want.end());
+      EXPECT_EQ(got, expected) << "depth " << depth << ", every " << every << " elements";
+    }
+  }
+}
+
 TEST(SeedConnectivity, VoxelCutKeepsWhatTheSeedsReachAndFillsHoles)
 {
   // Two bright disks; the right one has a dark hole. One object seed, in the left disk.

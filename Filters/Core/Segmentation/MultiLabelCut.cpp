@@ -341,7 +341,8 @@ void SolveLabels(PottsProblem& pr, std::vector<std::int16_t> hard, const std::ve
   const SharedArray<double>& step, const std::vector<double>& contact, const std::vector<double>& size,
   const std::vector<std::uint8_t>& border, const SeededCutParameters& par, const MultiLabelParameters& multi,
   std::vector<double> reach, std::vector<std::uint8_t> start, const ParallelFor& parallel,
-  const ProgressFunction& progress, MultiLabelCache* cache, Clock::time_point t0, MultiLabelResult& r)
+  const ProgressFunction& progress, MultiLabelCache* cache, Clock::time_point t0, MultiLabelResult& r,
+  const ContactsFunction& contactsOf)
 {
   const GraphEdges& edges = *pr.Edges;
   r.Error = GraphSizeProblem(pr.Nodes, edges.Size()); // before the geodesic term's 32-bit ids
@@ -411,7 +412,9 @@ void SolveLabels(PottsProblem& pr, std::vector<std::int16_t> hard, const std::ve
   r.Cycles = x.Cycles;
   r.Label = std::move(x.Label);
   r.ConnectivityChanged =
-    ApplyLabelConnectivity(ConnectivityFor(par.Connectivity, par.Task), r.Label, edges, pr.Weight, hard, border);
+    ApplyWithContacts(r.Label, contactsOf, [&](std::vector<std::uint8_t>& label, const GraphEdges& contacts) {
+      return ApplyLabelConnectivity(ConnectivityFor(par.Connectivity, par.Task), label, edges, pr.Weight, hard, border, contacts);
+    });
 }
 } // namespace
 
@@ -694,7 +697,8 @@ std::string ValidateSeedLabels(const std::vector<double>& labels)
 }
 
 std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>& label, const GraphEdges& edges,
-  const std::vector<double>& weight, const std::vector<std::int16_t>& hard, const std::vector<std::uint8_t>& border)
+  const std::vector<double>& weight, const std::vector<std::int16_t>& hard, const std::vector<std::uint8_t>& border,
+  const GraphEdges& contacts)
 {
   if (mode == Connectivity::Off)
   {
@@ -705,7 +709,8 @@ std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>
   const std::int64_t n = static_cast<std::int64_t>(label.size());
   std::int64_t count = 0;
   std::vector<std::int64_t> edge; // (p, q, e) of the edges between labels
-  const std::vector<std::int64_t> comp = LabelComponents(label, edges, count, NoProgress(), &edge);
+  std::vector<std::int64_t> comp = LabelComponents(label, edges, count, NoProgress(), &edge);
+  JoinContacts(label, contacts, comp, count);
   std::vector<std::int64_t> root(count), size(count, 0);
   std::iota(root.begin(), root.end(), std::int64_t(0));
   std::vector<std::uint8_t> group(count, 0), seeded(count, 0), touches(count, 0);
@@ -883,7 +888,8 @@ MultiLabelResult MultiLabelSuperVoxelCut(const SimplexMesh& mesh, const SuperVox
     SeedReachCosts(MeshCentres(mesh, data), seeds.Voxel, seeds.Label, L, par.Reach, parallel, reach, &r.ReachDistance);
   }
   SolveLabels(pr, hard, mean, bins, step, contact.Vector(),
-    count, border, par, multi, std::move(reach), std::move(start), parallel, progress, cache, t0, r);
+    count, border, par, multi, std::move(reach), std::move(start), parallel, progress, cache, t0, r,
+    [&](const std::vector<std::int64_t>& elements) { return VoxelContactsOf(mesh, data.Owner, elements); });
   if (!r.Error.empty() || r.Aborted)
   {
     return r;
@@ -935,7 +941,7 @@ MultiLabelResult MultiLabelVoxelCut(const std::vector<double>& values, const Cha
     SeedReachCosts(VoxelCentres(g), seeds.Voxel, seeds.Label, L, par.Reach, parallel, reach, &r.ReachDistance);
   }
   SolveLabels(pr, hard, values, bins, {}, {}, {}, BorderVoxels(g), par, multi, std::move(reach), {}, parallel, progress,
-    nullptr, t0, r);
+    nullptr, t0, r, nullptr);
   return r;
 }
 } // namespace featuremesh

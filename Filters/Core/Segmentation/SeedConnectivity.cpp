@@ -85,10 +85,93 @@ std::vector<std::int64_t> LabelComponents(const std::vector<std::uint8_t>& label
   return id; // not a conditional expression, which would copy it
 }
 
+void JoinContacts(const std::vector<std::uint8_t>& label, const GraphEdges& contacts, std::vector<std::int64_t>& id,
+  std::int64_t& count)
+{
+  if (contacts.Size() == 0)
+  {
+    return;
+  }
+  std::vector<std::int64_t> root(count);
+  std::iota(root.begin(), root.end(), std::int64_t(0));
+  bool joined = false;
+  contacts.ForEach([&](std::int64_t, std::int64_t p, std::int64_t q) {
+    if (label[p] == label[q] && id[p] != id[q])
+    {
+      std::int64_t a = Find(root, id[p]), b = Find(root, id[q]);
+      if (a != b)
+      {
+        root[std::max(a, b)] = std::min(a, b);
+        joined = true;
+      }
+    }
+  });
+  if (!joined)
+  {
+    return;
+  }
+  // A root is the smallest of its components, so it is numbered before them.
+  std::vector<std::int64_t> number(count, -1);
+  std::int64_t next = 0;
+  for (std::int64_t c = 0; c < count; ++c)
+  {
+    const std::int64_t r = Find(root, c);
+    number[c] = r == c ? next++ : number[r];
+  }
+  for (std::int64_t& c : id)
+  {
+    c = number[c];
+  }
+  count = next;
+}
+
+std::int64_t ApplyWithContacts(std::vector<std::uint8_t>& label, const ContactsFunction& contactsOf,
+  const std::function<std::int64_t(std::vector<std::uint8_t>&, const GraphEdges&)>& apply)
+{
+  const std::vector<std::uint8_t> given = label;
+  std::int64_t changed = apply(label, GraphEdges());
+  std::vector<std::uint8_t> seen(label.size(), 0);
+  std::vector<std::int64_t> nodes;
+  // Each pass adds nodes: at most as many passes as nodes, in practice two or three.
+  while (contactsOf && changed > 0)
+  {
+    const std::size_t before = nodes.size();
+    for (std::size_t p = 0; p < label.size(); ++p)
+    {
+      if (label[p] != given[p] && !seen[p])
+      {
+        seen[p] = 1;
+        nodes.push_back(static_cast<std::int64_t>(p));
+      }
+    }
+    if (nodes.size() == before)
+    {
+      break;
+    }
+    std::sort(nodes.begin(), nodes.end());
+    // Only pairs of one label can join; without any, the last run stands.
+    std::vector<std::int64_t> a, b;
+    contactsOf(nodes).ForEach([&](std::int64_t, std::int64_t p, std::int64_t q) {
+      if (given[p] == given[q])
+      {
+        a.push_back(p);
+        b.push_back(q);
+      }
+    });
+    if (a.empty())
+    {
+      break;
+    }
+    label = given;
+    changed = apply(label, GraphEdges(a, b));
+  }
+  return changed;
+}
+
 std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label, const GraphEdges& edges,
   const std::vector<std::uint8_t>& hard,
   const std::vector<std::uint8_t>& border, const ProgressFunction& progress, std::vector<double>* objectSizes,
-  const std::vector<double>& size, std::vector<std::int64_t>* objectComponent)
+  const std::vector<double>& size, std::vector<std::int64_t>* objectComponent, const GraphEdges& contacts)
 {
   if (mode == Connectivity::Off && !objectSizes)
   {
@@ -99,11 +182,12 @@ std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& lab
   const std::int64_t n = static_cast<std::int64_t>(label.size());
   std::int64_t count = 0;
   std::vector<std::int64_t> between;
-  const std::vector<std::int64_t> id = LabelComponents(label, edges, count, SubProgress(progress, 0.0, 0.8), &between);
+  std::vector<std::int64_t> id = LabelComponents(label, edges, count, SubProgress(progress, 0.0, 0.8), &between);
   if (static_cast<std::int64_t>(id.size()) != n)
   {
     return -1;
   }
+  JoinContacts(label, contacts, id, count);
   const bool rules = mode != Connectivity::Off;
   std::vector<std::uint8_t> value(count, 0), objectSeed(count, 0), anchored(count, 0);
   std::vector<std::int64_t> nodes(count, 0);

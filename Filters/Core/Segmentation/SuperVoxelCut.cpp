@@ -2,6 +2,7 @@
 #include "ElementRasterizer.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 
@@ -218,6 +219,92 @@ SharedArray<double> MeshContact(const SimplexMesh& mesh, const SuperVoxelCutData
                                                                  : SharedArray<double>(ContactInVoxelFaces(mesh, scale));
 }
 
+GraphEdges VoxelContactsOf(const SimplexMesh& mesh, const VoxelOwnerMap& owner, const std::vector<std::int64_t>& elements)
+{
+  const ImageGeometry& g = mesh.Geometry();
+  const std::int64_t m = mesh.NumberOfElements();
+  std::vector<std::uint64_t> found;
+  if (static_cast<std::int64_t>(owner.size()) != g.Size() || m >= (std::int64_t(1) << 31))
+  {
+    return GraphEdges::Owned({}, {});
+  }
+  const auto key = [](std::int64_t a, std::int64_t b) {
+    return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint64_t>(std::max(a, b));
+  };
+  std::vector<std::uint8_t> listed(m, 0);
+  for (const std::int64_t e : elements)
+  {
+    listed[e] = 1;
+  }
+  std::vector<std::uint64_t> faces;
+  const FaceAdjacency& adjacency = mesh.Faces();
+  for (std::size_t f = 0; f < adjacency.A.size(); ++f)
+  {
+    if (listed[adjacency.A[f]] || listed[adjacency.B[f]])
+    {
+      faces.push_back(key(adjacency.A[f], adjacency.B[f]));
+    }
+  }
+  std::sort(faces.begin(), faces.end());
+  const int vpc = mesh.VerticesPerCell();
+  const std::array<std::int64_t, 3> stride{ { 1, g.Dims[0], g.SliceStride() } };
+  for (const std::int64_t e : elements)
+  {
+    // The element's voxels lie in the box of its vertices.
+    std::array<int, 3> low{ { 0, 0, 0 } }, high{ { 0, 0, 0 } };
+    for (int a = 0; a < 3; ++a)
+    {
+      double lo = mesh.Points()[mesh.Cell(e)[0]][a], hi = lo;
+      for (int k = 1; k < vpc; ++k)
+      {
+        lo = std::min(lo, mesh.Points()[mesh.Cell(e)[k]][a]);
+        hi = std::max(hi, mesh.Points()[mesh.Cell(e)[k]][a]);
+      }
+      low[a] = std::max(0, static_cast<int>(std::floor(lo)));
+      high[a] = std::min(g.Dims[a] - 1, static_cast<int>(std::ceil(hi)));
+    }
+    for (int k = low[2]; k <= high[2]; ++k)
+    {
+      for (int j = low[1]; j <= high[1]; ++j)
+      {
+        for (int i = low[0]; i <= high[0]; ++i)
+        {
+          const std::int64_t v = g.Index(i, j, k);
+          if (owner[v] != e)
+          {
+            continue;
+          }
+          const std::array<int, 3> at{ { i, j, k } };
+          for (int a = 0; a < 3; ++a)
+          {
+            for (const int s : { -1, 1 })
+            {
+              if (at[a] + s < 0 || at[a] + s >= g.Dims[a])
+              {
+                continue;
+              }
+              const std::int32_t c = owner[v + s * stride[a]];
+              if (c >= 0 && c != e && !std::binary_search(faces.begin(), faces.end(), key(e, c)))
+              {
+                found.push_back(key(e, c));
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  std::sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
+  std::vector<std::int64_t> a(found.size()), b(found.size());
+  for (std::size_t e = 0; e < found.size(); ++e)
+  {
+    a[e] = static_cast<std::int64_t>(found[e] >> 32);
+    b[e] = static_cast<std::int64_t>(found[e] & 0xffffffffu);
+  }
+  return GraphEdges::Owned(std::move(a), std::move(b));
+}
+
 bool PrepareVoxelOwners(const SimplexMesh& mesh, SuperVoxelCutData& data, const ParallelFor& parallel,
   const ProgressFunction& progress)
 {
@@ -342,8 +429,13 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   {
     border[e] = 1;
   }
-  result.Cut.ConnectivityChanged = ApplyConnectivity(ConnectivityFor(parameters.Connectivity, parameters.Task), result.Cut.Label, pr.Edges, pr.Hard,
-    border, NoProgress(), &result.Cut.ObjectComponentVoxels, voxelCount.Vector(), &result.ObjectComponent);
+  const Connectivity rule = ConnectivityFor(parameters.Connectivity, parameters.Task);
+  result.Cut.ConnectivityChanged = ApplyWithContacts(result.Cut.Label,
+    [&](const std::vector<std::int64_t>& elements) { return VoxelContactsOf(mesh, owner, elements); },
+    [&](std::vector<std::uint8_t>& label, const GraphEdges& contacts) {
+      return ApplyConnectivity(rule, label, pr.Edges, pr.Hard, border, NoProgress(), &result.Cut.ObjectComponentVoxels,
+        voxelCount.Vector(), &result.ObjectComponent, contacts);
+    });
   result.BoundaryFaces = LabelBoundaryFaces(mesh, adj, result.Cut.Label);
   return result;
 }

@@ -146,6 +146,12 @@ SharedArray<double> MeshCentreSteps(const SimplexMesh& mesh, const SuperVoxelCut
 SharedArray<double> MeshContact(const SimplexMesh& mesh, const SuperVoxelCutData& data, bool scale);
 NodeCentres MeshCentres(const SimplexMesh& mesh, const SuperVoxelCutData& data);
 
+// The element pairs, one of them in `elements` (ascending), whose voxels share a voxel face while
+// the elements share no face (they meet at an edge or a vertex): the label image joins them where
+// the mesh's faces do not, so the connectivity rules count them as connected (ApplyWithContacts).
+// Each pair once (A < B), ascending.
+GraphEdges VoxelContactsOf(const SimplexMesh& mesh, const VoxelOwnerMap& owner, const std::vector<std::int64_t>& elements);
+
 // The element owning each voxel into `data.Owner`, by rasterising the mesh unless it already holds
 // them (stage 2's, say). False when progress asked to abort.
 bool PrepareVoxelOwners(const SimplexMesh& mesh, SuperVoxelCutData& data, const ParallelFor& parallel,
