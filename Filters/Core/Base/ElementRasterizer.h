@@ -140,6 +140,41 @@ private:
   std::int64_t N = 0;
 };
 
+// Calls f(v) for each voxel v that `owner` gives element e, from the box of e's vertices (index
+// space): an owned voxel's centre lies in its element.
+template <typename F>
+void ForEachVoxelOf(const SimplexMesh& mesh, const VoxelOwnerMap& owner, std::int64_t e, F&& f)
+{
+  const ImageGeometry& g = mesh.Geometry();
+  const std::int64_t* cell = mesh.Cell(e);
+  std::array<int, 3> low{ { 0, 0, 0 } }, high{ { 0, 0, 0 } };
+  for (int d = 0; d < 3; ++d)
+  {
+    double lo = mesh.Points()[cell[0]][d], hi = lo;
+    for (int j = 1; j < mesh.VerticesPerCell(); ++j)
+    {
+      lo = std::min(lo, mesh.Points()[cell[j]][d]);
+      hi = std::max(hi, mesh.Points()[cell[j]][d]);
+    }
+    low[d] = std::max(0, static_cast<int>(std::ceil(lo)));
+    high[d] = std::min(g.Dims[d] - 1, static_cast<int>(std::floor(hi)));
+  }
+  for (int z = low[2]; z <= high[2]; ++z)
+  {
+    for (int y = low[1]; y <= high[1]; ++y)
+    {
+      for (int x = low[0]; x <= high[0]; ++x)
+      {
+        const std::int64_t v = g.Index(x, y, z);
+        if (owner[v] == e)
+        {
+          f(v);
+        }
+      }
+    }
+  }
+}
+
 // Owner element of every voxel (-1 where none, which only happens when the mesh does not tile the box).
 // Empty when progress asked to abort. Element ids are 32-bit: 4 bytes per voxel.
 std::vector<std::int32_t> VoxelOwners(const ElementRasterizer& raster, const ParallelFor& parallel,

@@ -246,53 +246,27 @@ GraphEdges VoxelContactsOf(const SimplexMesh& mesh, const VoxelOwnerMap& owner, 
     }
   }
   std::sort(faces.begin(), faces.end());
-  const int vpc = mesh.VerticesPerCell();
   const std::array<std::int64_t, 3> stride{ { 1, g.Dims[0], g.SliceStride() } };
   for (const std::int64_t e : elements)
   {
-    // The element's voxels lie in the box of its vertices.
-    std::array<int, 3> low{ { 0, 0, 0 } }, high{ { 0, 0, 0 } };
-    for (int a = 0; a < 3; ++a)
-    {
-      double lo = mesh.Points()[mesh.Cell(e)[0]][a], hi = lo;
-      for (int k = 1; k < vpc; ++k)
+    ForEachVoxelOf(mesh, owner, e, [&](std::int64_t v) {
+      const std::array<int, 3> at = g.Coordinates(v);
+      for (int a = 0; a < 3; ++a)
       {
-        lo = std::min(lo, mesh.Points()[mesh.Cell(e)[k]][a]);
-        hi = std::max(hi, mesh.Points()[mesh.Cell(e)[k]][a]);
-      }
-      low[a] = std::max(0, static_cast<int>(std::floor(lo)));
-      high[a] = std::min(g.Dims[a] - 1, static_cast<int>(std::ceil(hi)));
-    }
-    for (int k = low[2]; k <= high[2]; ++k)
-    {
-      for (int j = low[1]; j <= high[1]; ++j)
-      {
-        for (int i = low[0]; i <= high[0]; ++i)
+        for (const int s : { -1, 1 })
         {
-          const std::int64_t v = g.Index(i, j, k);
-          if (owner[v] != e)
+          if (at[a] + s < 0 || at[a] + s >= g.Dims[a])
           {
             continue;
           }
-          const std::array<int, 3> at{ { i, j, k } };
-          for (int a = 0; a < 3; ++a)
+          const std::int32_t c = owner[v + s * stride[a]];
+          if (c >= 0 && c != e && !std::binary_search(faces.begin(), faces.end(), key(e, c)))
           {
-            for (const int s : { -1, 1 })
-            {
-              if (at[a] + s < 0 || at[a] + s >= g.Dims[a])
-              {
-                continue;
-              }
-              const std::int32_t c = owner[v + s * stride[a]];
-              if (c >= 0 && c != e && !std::binary_search(faces.begin(), faces.end(), key(e, c)))
-              {
-                found.push_back(key(e, c));
-              }
-            }
+            found.push_back(key(e, c));
           }
         }
       }
-    }
+    });
   }
   std::sort(found.begin(), found.end());
   found.erase(std::unique(found.begin(), found.end()), found.end());

@@ -264,30 +264,7 @@ std::vector<std::int64_t> BandVoxels(const SimplexMesh& mesh, const VoxelOwnerMa
       const std::int64_t last = std::min(static_cast<std::int64_t>(elements.size()), (c + 1) * chunk);
       for (std::int64_t k = c * chunk; k < last; ++k)
       {
-        const std::int64_t e = elements[k];
-        const std::int64_t* cell = mesh.Cell(e);
-        std::array<int, 3> low{ { 0, 0, 0 } }, high{ { 0, 0, 0 } };
-        for (int d = 0; d < 3; ++d)
-        {
-          double lo = mesh.Points()[cell[0]][d], hi = lo;
-          for (int j = 1; j < vpc; ++j)
-          {
-            lo = std::min(lo, mesh.Points()[cell[j]][d]);
-            hi = std::max(hi, mesh.Points()[cell[j]][d]);
-          }
-          low[d] = std::max(0, static_cast<int>(std::ceil(lo)));
-          high[d] = std::min(g.Dims[d] - 1, static_cast<int>(std::floor(hi)));
-        }
-        for (int z = low[2]; z <= high[2]; ++z)
-          for (int y = low[1]; y <= high[1]; ++y)
-            for (int x = low[0]; x <= high[0]; ++x)
-            {
-              const std::int64_t v = g.Index(x, y, z);
-              if (owner[v] == e)
-              {
-                found[c].push_back(v);
-              }
-            }
+        ForEachVoxelOf(mesh, owner, elements[k], [&](std::int64_t v) { found[c].push_back(v); });
       }
     }
   });
