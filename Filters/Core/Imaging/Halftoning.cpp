@@ -135,12 +135,15 @@ std::vector<std::int64_t> HalftoneInMedianVoxels(const float* rho, const ImageGe
   {
     const int ck = static_cast<int>(d / cellSlice), cj = static_cast<int>(d % cellSlice / cells[0]),
               ci = static_cast<int>(d % cells[0]);
+    const auto [i0, i1] = run(0, ci);
+    const auto [j0, j1] = run(1, cj);
+    const auto [k0, k1] = run(2, ck);
     std::int64_t peak = -1;
-    for (int k = run(2, ck)[0]; k < run(2, ck)[1]; ++k)
+    for (int k = k0; k < k1; ++k)
     {
-      for (int j = run(1, cj)[0]; j < run(1, cj)[1]; ++j)
+      for (int j = j0; j < j1; ++j)
       {
-        for (int i = run(0, ci)[0]; i < run(0, ci)[1]; ++i)
+        for (int i = i0; i < i1; ++i)
         {
           const std::int64_t v = g.Index(i, j, k);
           peak = peak < 0 || rho[v] > rho[peak] ? v : peak;

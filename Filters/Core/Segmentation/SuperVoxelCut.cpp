@@ -222,31 +222,25 @@ SharedArray<double> MeshContact(const SimplexMesh& mesh, const SuperVoxelCutData
 GraphEdges VoxelContactsOf(const SimplexMesh& mesh, const VoxelOwnerMap& owner, const std::vector<std::int64_t>& elements)
 {
   const ImageGeometry& g = mesh.Geometry();
-  const std::int64_t m = mesh.NumberOfElements();
-  std::vector<std::uint64_t> found;
-  if (static_cast<std::int64_t>(owner.size()) != g.Size() || m >= (std::int64_t(1) << 31))
+  if (static_cast<std::int64_t>(owner.size()) != g.Size() || mesh.NumberOfElements() >= (std::int64_t(1) << 31))
   {
     return GraphEdges::Owned({}, {});
   }
   const auto key = [](std::int64_t a, std::int64_t b) {
     return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint64_t>(std::max(a, b));
   };
-  std::vector<std::uint8_t> listed(m, 0);
-  for (const std::int64_t e : elements)
-  {
-    listed[e] = 1;
-  }
-  std::vector<std::uint64_t> faces;
-  const FaceAdjacency& adjacency = mesh.Faces();
-  for (std::size_t f = 0; f < adjacency.A.size(); ++f)
-  {
-    if (listed[adjacency.A[f]] || listed[adjacency.B[f]])
+  // Two elements of a conforming mesh share a face when they share all but one vertex.
+  const int vpc = mesh.VerticesPerCell();
+  const auto shareFace = [&](std::int64_t a, std::int64_t c) {
+    int common = 0;
+    for (int i = 0; i < vpc; ++i)
     {
-      faces.push_back(key(adjacency.A[f], adjacency.B[f]));
+      common += static_cast<int>(std::count(mesh.Cell(c), mesh.Cell(c) + vpc, mesh.Cell(a)[i]));
     }
-  }
-  std::sort(faces.begin(), faces.end());
+    return common == vpc - 1;
+  };
   const std::array<std::int64_t, 3> stride{ { 1, g.Dims[0], g.SliceStride() } };
+  std::vector<std::uint64_t> found;
   for (const std::int64_t e : elements)
   {
     ForEachVoxelOf(mesh, owner, e, [&](std::int64_t v) {
@@ -260,7 +254,7 @@ GraphEdges VoxelContactsOf(const SimplexMesh& mesh, const VoxelOwnerMap& owner, 
             continue;
           }
           const std::int32_t c = owner[v + s * stride[a]];
-          if (c >= 0 && c != e && !std::binary_search(faces.begin(), faces.end(), key(e, c)))
+          if (c >= 0 && c != e && !shareFace(e, c))
           {
             found.push_back(key(e, c));
           }
