@@ -148,31 +148,38 @@ bool SeedReachCosts(const NodeCentres& nodes, const std::vector<std::int64_t>& s
   const std::int64_t n = nodes.Size();
   const int objects = labels - 1;
   cost.resize(static_cast<std::size_t>(n) * objects);
+  // Seeds outer, nodes inner, over blocks of nodes held as coordinate rows: the inner loop
+  // vectorises (most nodes lie beyond the reach of every seed, so every seed is visited).
+  constexpr std::int64_t Block = 512;
   parallel(n, 16384, [&](std::int64_t p0, std::int64_t p1) {
-    for (std::int64_t q = p0; q < p1; ++q)
+    std::array<std::array<double, Block>, 3> x;
+    std::array<double, Block> d2;
+    for (std::int64_t b = p0; b < p1; b += Block)
     {
-      const Point x = nodes(q);
+      const std::int64_t m = std::min(Block, p1 - b);
+      for (std::int64_t i = 0; i < m; ++i)
+      {
+        const Point c = nodes(b + i);
+        x[0][i] = c[0];
+        x[1][i] = c[1];
+        x[2][i] = c[2];
+      }
       for (int l = 1; l < labels; ++l)
       {
-        double& c = cost[q * objects + l - 1];
-        c = 0.0;
-        if (R[l] == 0.0)
-        {
-          continue;
-        }
         const double free2 = (p.Reach * R[l]) * (p.Reach * R[l]);
-        double d2 = std::numeric_limits<double>::infinity();
+        std::fill(d2.begin(), d2.begin() + m, std::numeric_limits<double>::infinity());
         for (const Point& s : near[l])
         {
-          d2 = std::min(d2, Distance2(x, s));
-          if (d2 <= free2)
+          for (std::int64_t i = 0; i < m; ++i)
           {
-            break;
+            const double d = (x[0][i] - s[0]) * (x[0][i] - s[0]) + (x[1][i] - s[1]) * (x[1][i] - s[1]) +
+              (x[2][i] - s[2]) * (x[2][i] - s[2]);
+            d2[i] = std::min(d2[i], d);
           }
         }
-        if (d2 > free2)
+        for (std::int64_t i = 0; i < m; ++i)
         {
-          c = p.Weight * (std::sqrt(d2) / R[l] - p.Reach);
+          cost[(b + i) * objects + l - 1] = R[l] > 0.0 && d2[i] > free2 ? p.Weight * (std::sqrt(d2[i]) / R[l] - p.Reach) : 0.0;
         }
       }
     }
