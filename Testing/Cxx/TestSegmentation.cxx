@@ -775,11 +775,34 @@ TEST(SeedConnectivity, ContactsJoinComponentsOfOneLabel)
       }
     return GraphEdges::Owned(a, b);
   };
-  ApplyWithContacts(lazy, contactsOf, [&](std::vector<std::uint8_t>& l, const GraphEdges& contacts) {
-    return ApplyConnectivity(Connectivity::SeededObject, l, GraphEdges(A, B), hard, border, NoProgress(), nullptr, {}, nullptr, contacts);
+  // Every run starts from the labels as given, so the components the first run keeps serve the
+  // others: they stay those of the given labels, without the contacts' joins.
+  const std::vector<std::uint8_t> given = lazy;
+  std::vector<LabelComponentsOf> seen;
+  ApplyWithContacts(lazy, contactsOf, [&](std::vector<std::uint8_t>& l, const GraphEdges& contacts, LabelComponentsOf& components) {
+    EXPECT_EQ(l, given);
+    const std::int64_t changed = ApplyConnectivity(
+      Connectivity::SeededObject, l, GraphEdges(A, B), hard, border, NoProgress(), nullptr, {}, nullptr, contacts, &components);
+    seen.push_back(components);
+    return changed;
   });
   EXPECT_EQ(lazy, label);
   EXPECT_EQ(asked, (std::vector<std::vector<std::int64_t>>{ { 2, 4 }, { 1, 2, 4 } }));
+  ASSERT_EQ(seen.size(), 3u);
+  for (const LabelComponentsOf& c : seen)
+  {
+    EXPECT_EQ(c.Count, 5);
+    EXPECT_EQ(c.Id, (std::vector<std::int64_t>{ 0, 1, 2, 3, 4 }));
+    EXPECT_EQ(c.Between.size(), 12u); // the four edges, each between two labels
+  }
+  // Components kept from other labels are not taken for these: fewer ids than nodes are made afresh.
+  LabelComponentsOf stale;
+  stale.Id = { 0, 0 };
+  std::vector<std::uint8_t> again = given;
+  ApplyConnectivity(Connectivity::SeededObject, again, GraphEdges(A, B), hard, border, NoProgress(), nullptr, {}, nullptr,
+    GraphEdges(CA, CB), &stale);
+  EXPECT_EQ(again, label);
+  EXPECT_EQ(stale.Count, 5);
 }
 
 TEST(SuperVoxelCut, VoxelContactsAreTheVoxelFacesTheMeshFacesMiss)

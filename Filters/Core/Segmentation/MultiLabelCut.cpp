@@ -412,8 +412,9 @@ void SolveLabels(PottsProblem& pr, std::vector<std::int16_t> hard, const std::ve
   r.Cycles = x.Cycles;
   r.Label = std::move(x.Label);
   r.ConnectivityChanged =
-    ApplyWithContacts(r.Label, contactsOf, [&](std::vector<std::uint8_t>& label, const GraphEdges& contacts) {
-      return ApplyLabelConnectivity(ConnectivityFor(par.Connectivity, par.Task), label, edges, pr.Weight, hard, border, contacts);
+    ApplyWithContacts(r.Label, contactsOf, [&](std::vector<std::uint8_t>& label, const GraphEdges& contacts, LabelComponentsOf& components) {
+      return ApplyLabelConnectivity(
+        ConnectivityFor(par.Connectivity, par.Task), label, edges, pr.Weight, hard, border, contacts, &components);
     });
 }
 } // namespace
@@ -698,7 +699,7 @@ std::string ValidateSeedLabels(const std::vector<double>& labels)
 
 std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>& label, const GraphEdges& edges,
   const std::vector<double>& weight, const std::vector<std::int16_t>& hard, const std::vector<std::uint8_t>& border,
-  const GraphEdges& contacts)
+  const GraphEdges& contacts, LabelComponentsOf* components)
 {
   if (mode == Connectivity::Off)
   {
@@ -707,9 +708,12 @@ std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>
   // The components of equal label once; then whole components are relabelled and joined, over the
   // edges between them.
   const std::int64_t n = static_cast<std::int64_t>(label.size());
-  std::int64_t count = 0;
-  std::vector<std::int64_t> edge; // (p, q, e) of the edges between labels
-  std::vector<std::int64_t> comp = LabelComponents(label, edges, count, NoProgress(), &edge);
+  LabelComponentsOf own;
+  LabelComponentsOf& given = components ? *components : own;
+  KeepLabelComponents(label, edges, given);
+  std::int64_t count = given.Count;
+  const std::vector<std::int64_t>& edge = given.Between; // (p, q, e) of the edges between labels
+  std::vector<std::int64_t> comp = components ? given.Id : std::move(given.Id);
   JoinContacts(label, contacts, comp, count);
   std::vector<std::int64_t> root(count), size(count, 0);
   std::iota(root.begin(), root.end(), std::int64_t(0));

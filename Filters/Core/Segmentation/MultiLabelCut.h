@@ -177,11 +177,11 @@ MultiLabelResult MultiLabelVoxelCut(const std::vector<double>& values, const Cha
 // The connectivity rule per label, in place: with Seeded Object a component of an object label that
 // holds none of that label's seeds, and with either rule a background component that holds no
 // background seed and touches no border, takes the label it shares most edge weight with. Returns
-// the nodes relabelled. `contacts` (optional) join components of equal label besides the edges
-// (ApplyConnectivity).
+// the nodes relabelled. `contacts` (optional) join components of equal label besides the edges, and
+// `components` (optional) keeps `label`'s as given (ApplyConnectivity).
 std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>& label, const GraphEdges& edges,
   const std::vector<double>& weight, const std::vector<std::int16_t>& hard, const std::vector<std::uint8_t>& border,
-  const GraphEdges& contacts = GraphEdges());
+  const GraphEdges& contacts = GraphEdges(), LabelComponentsOf* components = nullptr);
 
 // Empty when usable, else a sentence: labels beyond 255 or negative, fewer than two labels, a label
 // with no seed among 0..max.

@@ -85,6 +85,17 @@ std::vector<std::int64_t> LabelComponents(const std::vector<std::uint8_t>& label
   return id; // not a conditional expression, which would copy it
 }
 
+bool KeepLabelComponents(const std::vector<std::uint8_t>& label, const GraphEdges& edges, LabelComponentsOf& kept,
+  const ProgressFunction& progress)
+{
+  if (kept.Id.size() == label.size() && !label.empty())
+  {
+    return true;
+  }
+  kept.Id = LabelComponents(label, edges, kept.Count, progress, &kept.Between);
+  return kept.Id.size() == label.size();
+}
+
 void JoinContacts(const std::vector<std::uint8_t>& label, const GraphEdges& contacts, std::vector<std::int64_t>& id,
   std::int64_t& count)
 {
@@ -125,11 +136,11 @@ void JoinContacts(const std::vector<std::uint8_t>& label, const GraphEdges& cont
   count = next;
 }
 
-std::int64_t ApplyWithContacts(std::vector<std::uint8_t>& label, const ContactsFunction& contactsOf,
-  const std::function<std::int64_t(std::vector<std::uint8_t>&, const GraphEdges&)>& apply)
+std::int64_t ApplyWithContacts(std::vector<std::uint8_t>& label, const ContactsFunction& contactsOf, const ContactsRule& apply)
 {
   const std::vector<std::uint8_t> given = label;
-  std::int64_t changed = apply(label, GraphEdges());
+  LabelComponentsOf components;
+  std::int64_t changed = apply(label, GraphEdges(), components);
   std::vector<std::uint8_t> seen(label.size(), 0);
   std::vector<std::int64_t> nodes;
   // Each pass adds nodes: at most as many passes as nodes, in practice two or three.
@@ -163,7 +174,7 @@ std::int64_t ApplyWithContacts(std::vector<std::uint8_t>& label, const ContactsF
       break;
     }
     label = given;
-    changed = apply(label, GraphEdges(a, b));
+    changed = apply(label, GraphEdges(a, b), components);
   }
   return changed;
 }
@@ -171,7 +182,8 @@ std::int64_t ApplyWithContacts(std::vector<std::uint8_t>& label, const ContactsF
 std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label, const GraphEdges& edges,
   const std::vector<std::uint8_t>& hard,
   const std::vector<std::uint8_t>& border, const ProgressFunction& progress, std::vector<double>* objectSizes,
-  const std::vector<double>& size, std::vector<std::int64_t>* objectComponent, const GraphEdges& contacts)
+  const std::vector<double>& size, std::vector<std::int64_t>* objectComponent, const GraphEdges& contacts,
+  LabelComponentsOf* components)
 {
   if (mode == Connectivity::Off && !objectSizes)
   {
@@ -180,13 +192,15 @@ std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& lab
   // One pass over the edges: the components of equal label. Every later step relabels or joins
   // whole components, over the (few) edges between labels.
   const std::int64_t n = static_cast<std::int64_t>(label.size());
-  std::int64_t count = 0;
-  std::vector<std::int64_t> between;
-  std::vector<std::int64_t> id = LabelComponents(label, edges, count, SubProgress(progress, 0.0, 0.8), &between);
-  if (static_cast<std::int64_t>(id.size()) != n)
+  LabelComponentsOf own;
+  LabelComponentsOf& given = components ? *components : own;
+  if (!KeepLabelComponents(label, edges, given, SubProgress(progress, 0.0, 0.8)))
   {
     return -1;
   }
+  std::int64_t count = given.Count;
+  std::vector<std::int64_t> id = components ? given.Id : std::move(given.Id);
+  const std::vector<std::int64_t>& between = given.Between;
   JoinContacts(label, contacts, id, count);
   const bool rules = mode != Connectivity::Off;
   std::vector<std::uint8_t> value(count, 0), objectSeed(count, 0), anchored(count, 0);

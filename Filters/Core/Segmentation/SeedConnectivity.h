@@ -48,6 +48,20 @@ inline Connectivity ConnectivityFor(Connectivity mode, Task task)
 std::vector<std::int64_t> LabelComponents(const std::vector<std::uint8_t>& label, const GraphEdges& edges,
   std::int64_t& count, const ProgressFunction& progress = NoProgress(), std::vector<std::int64_t>* between = nullptr);
 
+// A labelling's components with the edges between labels (LabelComponents' id, count and
+// between), kept while the labels and edges stay: ApplyWithContacts runs its rule from the labels
+// as given on every pass, and only the contacts differ.
+struct LabelComponentsOf
+{
+  std::vector<std::int64_t> Id, Between;
+  std::int64_t Count = 0;
+};
+
+// The components of `label` into `kept` unless it holds `label`'s already (as many ids as nodes):
+// false when `progress` aborts.
+bool KeepLabelComponents(const std::vector<std::uint8_t>& label, const GraphEdges& edges, LabelComponentsOf& kept,
+  const ProgressFunction& progress = NoProgress());
+
 // Joins the components `id` (LabelComponents' numbering, `count` of them) of equal label that a
 // pair of `contacts` links, renumbered in order of each joined component's first node.
 void JoinContacts(const std::vector<std::uint8_t>& label, const GraphEdges& contacts, std::vector<std::int64_t>& id,
@@ -56,14 +70,16 @@ void JoinContacts(const std::vector<std::uint8_t>& label, const GraphEdges& cont
 // The contacts (node pairs, as JoinContacts takes them) of the given nodes.
 using ContactsFunction = std::function<GraphEdges(const std::vector<std::int64_t>& nodes)>;
 
-// A connectivity rule, `apply(label, contacts)` (returning the nodes it relabelled, -1 on abort), run
-// on `label` with the contacts of the nodes it relabels: first without contacts, then again from the
-// labels as given with those of every node relabelled so far, until no new node is relabelled. A
-// pair whose two nodes keep their labels changes no label, so the contacts of the relabelled
-// nodes are all the rule needs; a pass whose new contacts join no two nodes of one label is not run.
-// Without `contactsOf`, one run without contacts.
-std::int64_t ApplyWithContacts(std::vector<std::uint8_t>& label, const ContactsFunction& contactsOf,
-  const std::function<std::int64_t(std::vector<std::uint8_t>&, const GraphEdges&)>& apply);
+// A connectivity rule, `apply(label, contacts, components)` (returning the nodes it relabelled, -1 on
+// abort), run on `label` with the contacts of the nodes it relabels: first without contacts, then
+// again from the labels as given with those of every node relabelled so far, until no new node is
+// relabelled. A pair whose two nodes keep their labels changes no label, so the contacts of the
+// relabelled nodes are all the rule needs; a pass whose new contacts join no two nodes of one label
+// is not run. `components` are the given labels' (KeepLabelComponents): made by the first run, read
+// by the others. Without `contactsOf`, one run without contacts.
+using ContactsRule =
+  std::function<std::int64_t(std::vector<std::uint8_t>& label, const GraphEdges& contacts, LabelComponentsOf& components)>;
+std::int64_t ApplyWithContacts(std::vector<std::uint8_t>& label, const ContactsFunction& contactsOf, const ContactsRule& apply);
 
 // Applies `mode` to `label` (1 object, 0 background) in place; `hard` (0 free, 1 object seed, 2
 // background seed) and `border` (node touches the image border) per node. Seeded nodes keep their
@@ -73,11 +89,13 @@ std::int64_t ApplyWithContacts(std::vector<std::uint8_t>& label, const ContactsF
 // and `objectComponent` (optional, with objectSizes) each node's index among them (-1 background).
 // `contacts` (optional) are node pairs that connect besides the edges (mesh elements whose voxels
 // share a face without the elements sharing one): they join components of equal label.
+// `components` (optional) keeps `label`'s components as given (KeepLabelComponents).
 std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& label, const GraphEdges& edges,
   const std::vector<std::uint8_t>& hard,
   const std::vector<std::uint8_t>& border, const ProgressFunction& progress = NoProgress(),
   std::vector<double>* objectSizes = nullptr, const std::vector<double>& size = {},
-  std::vector<std::int64_t>* objectComponent = nullptr, const GraphEdges& contacts = GraphEdges());
+  std::vector<std::int64_t>* objectComponent = nullptr, const GraphEdges& contacts = GraphEdges(),
+  LabelComponentsOf* components = nullptr);
 
 // The sizes of the object components (sum of `size` over their nodes, 1 per node when `size` is
 // empty), largest first; empty when `progress` aborts.

@@ -400,9 +400,9 @@ SuperVoxelCutResult SuperVoxelCut(const SimplexMesh& mesh, const SuperVoxelCutDa
   const Connectivity rule = ConnectivityFor(parameters.Connectivity, parameters.Task);
   result.Cut.ConnectivityChanged = ApplyWithContacts(result.Cut.Label,
     [&](const std::vector<std::int64_t>& elements) { return VoxelContactsOf(mesh, owner, elements); },
-    [&](std::vector<std::uint8_t>& label, const GraphEdges& contacts) {
+    [&](std::vector<std::uint8_t>& label, const GraphEdges& contacts, LabelComponentsOf& components) {
       return ApplyConnectivity(rule, label, pr.Edges, pr.Hard, border, NoProgress(), &result.Cut.ObjectComponentVoxels,
-        voxelCount.Vector(), &result.ObjectComponent, contacts);
+        voxelCount.Vector(), &result.ObjectComponent, contacts, &components);
     });
   result.BoundaryFaces = LabelBoundaryFaces(mesh, adj, result.Cut.Label);
   return result;
