@@ -301,18 +301,29 @@ void AddFieldValues(vtkDataObject* object, std::initializer_list<std::pair<const
   }
 }
 
+namespace
+{
+// A field array `name` of n values, value(i) each.
+template <typename Value>
+void AddFieldArray(vtkDataObject* object, const char* name, std::size_t n, Value&& value)
+{
+  vtkNew<vtkDoubleArray> array;
+  array->SetName(name);
+  array->SetNumberOfValues(static_cast<vtkIdType>(n));
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    array->SetValue(static_cast<vtkIdType>(i), value(i));
+  }
+  object->GetFieldData()->AddArray(array);
+}
+} // namespace
+
 void AddObjectComponents(vtkDataObject* object, const std::vector<double>& componentVoxels, double voxelVolume,
   std::int64_t connectivityChanged)
 {
   AddFieldValue(object, names::ObjectComponents, static_cast<double>(componentVoxels.size()));
-  vtkNew<vtkDoubleArray> volumes;
-  volumes->SetName(names::ObjectComponentVolumes);
-  volumes->SetNumberOfValues(static_cast<vtkIdType>(componentVoxels.size()));
-  for (std::size_t c = 0; c < componentVoxels.size(); ++c)
-  {
-    volumes->SetValue(static_cast<vtkIdType>(c), componentVoxels[c] * voxelVolume);
-  }
-  object->GetFieldData()->AddArray(volumes);
+  AddFieldArray(object, names::ObjectComponentVolumes, componentVoxels.size(),
+    [&](std::size_t c) { return componentVoxels[c] * voxelVolume; });
   AddFieldValue(object, names::ConnectivityChanged, static_cast<double>(connectivityChanged));
 }
 
@@ -349,14 +360,9 @@ void AddMultiLabelFields(vtkDataObject* object, const MultiLabelResult& result, 
   AddFieldValue(object, names::ExpansionCycles, result.Cycles);
   AddFieldValue(object, names::ExpansionSeconds, result.ExpansionSeconds);
   AddFieldValue(object, names::GeodesicSeconds, result.GeodesicSeconds);
-  vtkNew<vtkDoubleArray> reach;
-  reach->SetName(names::SeedReachDistance);
-  reach->SetNumberOfTuples(result.Labels);
-  for (int l = 0; l < result.Labels; ++l)
-  {
-    reach->SetValue(l, l < static_cast<int>(result.ReachDistance.size()) ? result.ReachDistance[l] : 0.0);
-  }
-  object->GetFieldData()->AddArray(reach);
+  const std::vector<double>& reach = result.ReachDistance;
+  AddFieldArray(object, names::SeedReachDistance, static_cast<std::size_t>(std::max(result.Labels, 0)),
+    [&](std::size_t l) { return l < reach.size() ? reach[l] : 0.0; });
 }
 
 void SetLabelImage(vtkImageData* image, const ImageGeometry& geometry, const std::vector<std::uint8_t>& labels)

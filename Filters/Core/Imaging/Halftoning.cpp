@@ -106,50 +106,46 @@ std::vector<std::int64_t> HalftoneInMedianVoxels(const float* rho, const ImageGe
   {
     cells[a] = (g.Dims[a] + m[a] - 1) / m[a];
   }
-  // A cell's voxels: [c m, min((c + 1) m, Dims)) on each axis.
-  const auto run = [&](int a, int c) { return std::array<int, 2>{ { c * m[a], std::min((c + 1) * m[a], g.Dims[a]) } }; };
-  std::vector<float> means(cells[0]);
-  std::vector<std::int64_t> dots = Diffuse(cells, q, [&](int cj, int ck) {
-    const auto [j0, j1] = run(1, cj);
-    const auto [k0, k1] = run(2, ck);
-    for (int ci = 0; ci < cells[0]; ++ci)
+  // f(v) for each voxel of cell (ci, cj, ck): [c m, min((c + 1) m, Dims)) on each axis.
+  const auto forCell = [&](int ci, int cj, int ck, auto&& f) {
+    const std::array<int, 3> c{ { ci, cj, ck } };
+    std::array<int, 3> lo, hi;
+    for (int a = 0; a < 3; ++a)
     {
-      const auto [i0, i1] = run(0, ci);
-      double sum = 0.0;
-      for (int k = k0; k < k1; ++k)
+      lo[a] = c[a] * m[a];
+      hi[a] = std::min(lo[a] + m[a], g.Dims[a]);
+    }
+    for (int k = lo[2]; k < hi[2]; ++k)
+    {
+      for (int j = lo[1]; j < hi[1]; ++j)
       {
-        for (int j = j0; j < j1; ++j)
+        for (int i = lo[0]; i < hi[0]; ++i)
         {
-          for (int i = i0; i < i1; ++i)
-          {
-            sum += rho[g.Index(i, j, k)];
-          }
+          f(g.Index(i, j, k));
         }
       }
-      means[ci] = static_cast<float>(sum / ((i1 - i0) * (j1 - j0) * (k1 - k0)));
+    }
+  };
+  std::vector<float> means(cells[0]);
+  std::vector<std::int64_t> dots = Diffuse(cells, q, [&](int cj, int ck) {
+    for (int ci = 0; ci < cells[0]; ++ci)
+    {
+      double sum = 0.0;
+      int count = 0;
+      forCell(ci, cj, ck, [&](std::int64_t v) {
+        sum += rho[v];
+        ++count;
+      });
+      means[ci] = static_cast<float>(sum / count);
     }
     return means.data();
   });
   const std::int64_t cellSlice = static_cast<std::int64_t>(cells[0]) * cells[1];
   for (std::int64_t& d : dots)
   {
-    const int ck = static_cast<int>(d / cellSlice), cj = static_cast<int>(d % cellSlice / cells[0]),
-              ci = static_cast<int>(d % cells[0]);
-    const auto [i0, i1] = run(0, ci);
-    const auto [j0, j1] = run(1, cj);
-    const auto [k0, k1] = run(2, ck);
     std::int64_t peak = -1;
-    for (int k = k0; k < k1; ++k)
-    {
-      for (int j = j0; j < j1; ++j)
-      {
-        for (int i = i0; i < i1; ++i)
-        {
-          const std::int64_t v = g.Index(i, j, k);
-          peak = peak < 0 || rho[v] > rho[peak] ? v : peak;
-        }
-      }
-    }
+    forCell(static_cast<int>(d % cells[0]), static_cast<int>(d % cellSlice / cells[0]), static_cast<int>(d / cellSlice),
+      [&](std::int64_t v) { peak = peak < 0 || rho[v] > rho[peak] ? v : peak; });
     d = peak;
   }
   std::sort(dots.begin(), dots.end());

@@ -254,7 +254,6 @@ std::vector<std::int64_t> BandVoxels(const SimplexMesh& mesh, const VoxelOwnerMa
     }
   }
   const ImageGeometry& g = mesh.Geometry();
-  const int vpc = mesh.VerticesPerCell();
   constexpr std::int64_t chunk = 1024;
   const std::int64_t chunks = (static_cast<std::int64_t>(elements.size()) + chunk - 1) / chunk;
   std::vector<std::vector<std::int64_t>> found(chunks);
