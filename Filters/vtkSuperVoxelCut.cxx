@@ -36,12 +36,21 @@ vtkStandardNewMacro(vtkSuperVoxelCut);
 
 namespace
 {
-// A voxel's value, and the squared distance of two voxels' channel vectors, of an image in its own type.
+// The binary cut's cost of each label for voxel v of element e, lambda times its region and
+// spatial terms, reading the image in its own type.
 template <typename T>
-std::function<double(std::int64_t)> VoxelValue(const T* x)
+std::function<void(std::int64_t, std::int64_t, double*)> BinaryVoxelCost(
+  const T* x, const featuremesh::CutResult& cut, double lambda)
 {
-  return [x](std::int64_t v) { return static_cast<double>(x[v]); };
+  const bool spatial = !cut.SpatialObject.empty();
+  return [x, &cut, lambda, spatial](std::int64_t v, std::int64_t e, double* costs) {
+    const int b = cut.ValueBin(static_cast<double>(x[v]));
+    costs[0] = lambda * (cut.BinCostBackground[b] + (spatial ? cut.SpatialScale * cut.SpatialBackground[e] : 0.0));
+    costs[1] = lambda * (cut.BinCostObject[b] + (spatial ? cut.SpatialScale * cut.SpatialObject[e] : 0.0) +
+                          (cut.Reach.empty() ? 0.0 : cut.Reach[e]));
+  };
 }
+// The squared distance of two voxels' channel vectors, of an image in its own type.
 template <typename T>
 std::function<double(std::int64_t, std::int64_t)> ChannelDistance2(const T* x, int channels)
 {
@@ -397,21 +406,12 @@ featuremesh::VoxelRefinementResult vtkSuperVoxelCut::RefineBinary(featuremesh::S
   }
   std::vector<std::int64_t> seedVoxels = objectVoxels;
   seedVoxels.insert(seedVoxels.end(), backgroundVoxels.begin(), backgroundVoxels.end());
-  const bool spatial = !cut.SpatialObject.empty();
-  const double lambda = this->Lambda;
-  std::function<double(std::int64_t)> value;
+  std::function<void(std::int64_t, std::int64_t, double*)> cost;
   switch (values->GetDataType())
   {
-    vtkTemplateMacro(value = VoxelValue(static_cast<const VTK_TT*>(values->GetVoidPointer(0))));
+    vtkTemplateMacro(cost = BinaryVoxelCost(static_cast<const VTK_TT*>(values->GetVoidPointer(0)), cut, this->Lambda));
   }
-  VoxelRefinementResult refinement = this->Refine(cut.Label, 2, values, seedVoxels,
-    [&](std::int64_t v, std::int64_t e, double* costs) {
-      const int b = cut.ValueBin(value(v));
-      costs[0] = lambda * (cut.BinCostBackground[b] + (spatial ? cut.SpatialScale * cut.SpatialBackground[e] : 0.0));
-      costs[1] = lambda * (cut.BinCostObject[b] + (spatial ? cut.SpatialScale * cut.SpatialObject[e] : 0.0) +
-                            (cut.Reach.empty() ? 0.0 : cut.Reach[e]));
-    },
-    &result.ObjectComponent, 0.9);
+  VoxelRefinementResult refinement = this->Refine(cut.Label, 2, values, seedVoxels, cost, &result.ObjectComponent, 0.9);
   // The components' volumes hold the refined voxels too.
   std::vector<double>& volumes = result.Cut.ObjectComponentVoxels;
   for (std::size_t c = 0; c < refinement.ComponentChange.size() && c < volumes.size(); ++c)

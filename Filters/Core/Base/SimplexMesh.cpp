@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numeric>
 
@@ -357,6 +358,27 @@ std::shared_ptr<const FaceAdjacency> SimplexMesh::SharedFaces() const
   return this->Cached->Faces;
 }
 
+const std::vector<std::int32_t>& SimplexMesh::ElementFaces() const
+{
+  const FaceAdjacency& faces = this->Faces();
+  std::lock_guard<std::mutex> lock(this->Cached->Lock);
+  if (!this->Cached->ElementFaces)
+  {
+    auto table = std::make_shared<std::vector<std::int32_t>>();
+    if (faces.A.size() <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+    {
+      table->assign(static_cast<std::size_t>(this->NumberOfElements() * this->Vpc), -1);
+    }
+    for (std::size_t f = 0; f < faces.A.size() && !table->empty(); ++f)
+    {
+      (*table)[faces.A[f] * this->Vpc + faces.LocalA[f]] = static_cast<std::int32_t>(f);
+      (*table)[faces.B[f] * this->Vpc + faces.LocalB[f]] = static_cast<std::int32_t>(f);
+    }
+    this->Cached->ElementFaces = table;
+  }
+  return *this->Cached->ElementFaces;
+}
+
 const CompressedRows& SimplexMesh::Stars() const
 {
   std::lock_guard<std::mutex> lock(this->Cached->Lock);
@@ -532,7 +554,28 @@ std::vector<std::int64_t> LabelBoundaryFaces(const SimplexMesh& mesh, const Face
   const std::vector<std::uint8_t>& label, std::int64_t* interfaceFaces)
 {
   std::vector<std::pair<std::int64_t, int>> inner, hull;
-  for (std::size_t i = 0; i < adjacency.A.size(); ++i)
+  const int vpc = mesh.VerticesPerCell();
+  // Every face between two labels has an end of a label other than 0: the faces of those elements
+  // (most of a mesh is background), each face from the end it is listed by.
+  static const std::vector<std::int32_t> unlisted;
+  const std::vector<std::int32_t>& faceOf = &adjacency == &mesh.Faces() ? mesh.ElementFaces() : unlisted;
+  for (std::size_t e = 0; e < label.size() && !faceOf.empty(); ++e)
+  {
+    for (int k = 0; k < vpc && label[e]; ++k)
+    {
+      const std::int32_t i = faceOf[e * vpc + k];
+      if (i < 0)
+      {
+        continue;
+      }
+      const std::int64_t a = adjacency.A[i], b = adjacency.B[i];
+      if (label[a] != label[b] && static_cast<std::int64_t>(e) == (label[a] ? a : b))
+      {
+        inner.emplace_back(e, k);
+      }
+    }
+  }
+  for (std::size_t i = 0; i < adjacency.A.size() && faceOf.empty(); ++i)
   {
     const std::int64_t a = adjacency.A[i], b = adjacency.B[i];
     if (label[a] != label[b])
@@ -540,7 +583,6 @@ std::vector<std::int64_t> LabelBoundaryFaces(const SimplexMesh& mesh, const Face
       inner.emplace_back(label[a] ? a : b, label[a] ? adjacency.LocalA[i] : adjacency.LocalB[i]);
     }
   }
-  const int vpc = mesh.VerticesPerCell();
   for (std::size_t h = 0; h < adjacency.HullElement.size(); ++h)
   {
     const std::int64_t e = adjacency.HullElement[h];

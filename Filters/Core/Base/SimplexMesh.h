@@ -79,6 +79,10 @@ public:
   std::shared_ptr<const FaceAdjacency> SharedFaces() const;
   const CompressedRows& Stars() const;
   const CompressedRows& VertexNeighbours() const;
+  // Per element and local face (elements x VerticesPerCell()): the index of the interior face in
+  // Faces(), -1 on the hull; empty beyond 2^31 faces. Built on first use from Faces(): the faces of
+  // a few elements without a pass over every face.
+  const std::vector<std::int32_t>& ElementFaces() const;
 
 private:
   ImageGeometry Frame;
@@ -91,6 +95,7 @@ private:
     std::mutex Lock;
     std::shared_ptr<const FaceAdjacency> Faces;
     std::shared_ptr<const CompressedRows> Stars, Neighbours;
+    std::shared_ptr<const std::vector<std::int32_t>> ElementFaces;
   };
   std::shared_ptr<Cache> Cached = std::make_shared<Cache>();
 };

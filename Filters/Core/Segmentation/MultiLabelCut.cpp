@@ -713,8 +713,14 @@ std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>
   KeepLabelComponents(label, edges, given);
   std::int64_t count = given.Count;
   const std::vector<std::int64_t>& edge = given.Between; // (p, q, e) of the edges between labels
-  std::vector<std::int64_t> comp = components ? given.Id : std::move(given.Id);
-  JoinContacts(label, contacts, comp, count);
+  // The components as given, or a copy joined through the contacts.
+  std::vector<std::int64_t> joinedId;
+  if (contacts.Size() > 0)
+  {
+    joinedId = given.Id;
+    JoinContacts(label, contacts, joinedId, count);
+  }
+  const std::vector<std::int64_t>& comp = contacts.Size() > 0 ? joinedId : given.Id;
   std::vector<std::int64_t> root(count), size(count, 0);
   std::iota(root.begin(), root.end(), std::int64_t(0));
   std::vector<std::uint8_t> group(count, 0), seeded(count, 0), touches(count, 0);

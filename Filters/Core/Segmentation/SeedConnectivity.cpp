@@ -199,9 +199,15 @@ std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& lab
     return -1;
   }
   std::int64_t count = given.Count;
-  std::vector<std::int64_t> id = components ? given.Id : std::move(given.Id);
+  // The components as given, or a copy joined through the contacts.
+  std::vector<std::int64_t> joinedId;
+  if (contacts.Size() > 0)
+  {
+    joinedId = given.Id;
+    JoinContacts(label, contacts, joinedId, count);
+  }
+  const std::vector<std::int64_t>& id = contacts.Size() > 0 ? joinedId : given.Id;
   const std::vector<std::int64_t>& between = given.Between;
-  JoinContacts(label, contacts, id, count);
   const bool rules = mode != Connectivity::Off;
   std::vector<std::uint8_t> value(count, 0), objectSeed(count, 0), anchored(count, 0);
   std::vector<std::int64_t> nodes(count, 0);

@@ -193,7 +193,23 @@ void BandElements(const VoxelRefinementProblem& p, const FaceAdjacency& faces, s
   const std::int64_t n = static_cast<std::int64_t>(label.size());
   const std::int64_t m = static_cast<std::int64_t>(faces.A.size());
   band.assign(n, 0);
-  for (std::int64_t f = 0; f < m; ++f)
+  // Through the elements' own faces when the mesh lists them: every face between two labels has an
+  // end of a label other than 0, and each ring adds the band's face neighbours.
+  const std::vector<std::int32_t>& faceOf = p.Mesh->ElementFaces();
+  const int vpc = p.Mesh->VerticesPerCell();
+  const auto other = [&](std::int64_t e, std::int32_t f) { return faces.A[f] == e ? faces.B[f] : faces.A[f]; };
+  for (std::int64_t e = 0; e < n && !faceOf.empty(); ++e)
+  {
+    for (int k = 0; k < vpc && label[e]; ++k)
+    {
+      const std::int32_t f = faceOf[e * vpc + k];
+      if (f >= 0 && label[other(e, f)] != label[e])
+      {
+        band[e] = band[other(e, f)] = 1;
+      }
+    }
+  }
+  for (std::int64_t f = 0; f < m && faceOf.empty(); ++f)
   {
     if (label[faces.A[f]] != label[faces.B[f]])
     {
@@ -203,7 +219,18 @@ void BandElements(const VoxelRefinementProblem& p, const FaceAdjacency& faces, s
   for (int r = 1; r < p.Rings; ++r)
   {
     std::vector<std::uint8_t> grown = band;
-    for (std::int64_t f = 0; f < m; ++f)
+    for (std::int64_t e = 0; e < n && !faceOf.empty(); ++e)
+    {
+      for (int k = 0; k < vpc && band[e]; ++k)
+      {
+        const std::int32_t f = faceOf[e * vpc + k];
+        if (f >= 0)
+        {
+          grown[other(e, f)] = 1;
+        }
+      }
+    }
+    for (std::int64_t f = 0; f < m && faceOf.empty(); ++f)
     {
       grown[faces.A[f]] |= band[faces.B[f]];
       grown[faces.B[f]] |= band[faces.A[f]];
@@ -301,18 +328,22 @@ struct Band
   std::vector<std::uint64_t> Around; // per voxel: the labels of its neighbours outside the domain (bit l, l < 64)
   const std::vector<std::int32_t>& Index; // the domain's index map (State::Index), from voxel IndexFirst on
   std::int64_t IndexFirst;
+  const std::vector<std::uint8_t>& Sides;  // per voxel: its face neighbours on the grid (DescribeDomain)
+  const std::vector<std::int32_t>& Element; // per voxel: its element (-1 none)
   std::vector<std::uint8_t> Held, Own;    // per voxel: held, and its element's label (ReadElements)
   std::int64_t Stride[3];
   int Axes;
 
   Band(const VoxelRefinementProblem& p, const std::vector<std::int64_t>& voxels, const std::vector<std::int32_t>& index,
-    std::int64_t indexFirst)
+    std::int64_t indexFirst, const std::vector<std::uint8_t>& sides, const std::vector<std::int32_t>& element)
     : P(p)
     , G(p.Mesh->Geometry())
     , Voxel(voxels)
     , Around(Voxel.size(), 0)
     , Index(index)
     , IndexFirst(indexFirst)
+    , Sides(sides)
+    , Element(element)
     , Held(Voxel.size(), 0)
     , Own(Voxel.size(), 0)
     , Stride{ 1, G.Dims[0], G.SliceStride() }
@@ -331,8 +362,8 @@ struct Band
       {
         for (std::int64_t i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i)
         {
-          const std::int32_t e = (*this->P.Owner)[this->Voxel[i]];
-          this->Own[i] = e >= 0 ? (*this->P.Label)[e] : std::uint8_t(0);
+          const std::int32_t e = this->Element[i];
+          this->Own[i] = this->LabelOf(e);
           this->Held[i] = e < 0 || !bandElement[e];
           free[c] += !this->Held[i];
         }
@@ -343,11 +374,8 @@ struct Band
   Band(const Band&) = delete;
   Band& operator=(const Band&) = delete;
   std::int64_t Size() const { return static_cast<std::int64_t>(this->Voxel.size()); }
-  std::uint8_t ElementLabel(std::int64_t v) const
-  {
-    const std::int32_t e = (*this->P.Owner)[v];
-    return e >= 0 ? (*this->P.Label)[e] : std::uint8_t(0);
-  }
+  std::uint8_t LabelOf(std::int32_t e) const { return e >= 0 ? (*this->P.Label)[e] : std::uint8_t(0); }
+  std::uint8_t ElementLabel(std::int64_t v) const { return this->LabelOf((*this->P.Owner)[v]); }
   // The domain index of voxel u, -1 outside the domain.
   std::int64_t Find(std::int64_t u) const
   {
@@ -386,6 +414,35 @@ struct Band
       }
     }
   }
+
+  // Neighbours() of the domain's voxel i, from its Sides instead of its coordinates.
+  template <typename F>
+  void DomainNeighbours(std::int64_t i, F&& f, bool* border = nullptr) const
+  {
+    const std::int64_t v = this->Voxel[i];
+    const unsigned sides = this->Sides[i];
+    for (int d = 0; d < this->Axes; ++d)
+    {
+      if ((sides >> (2 * d)) & 1u)
+      {
+        f(v + this->Stride[d], true);
+      }
+      else if (border)
+      {
+        *border = true;
+      }
+      if ((sides >> (2 * d + 1)) & 1u)
+      {
+        f(v - this->Stride[d], false);
+      }
+      else if (border)
+      {
+        *border = true;
+      }
+    }
+  }
+  // Whether the domain's voxel i lies on the image's border.
+  bool OnBorder(std::int64_t i) const { return this->Sides[i] != (1u << (2 * this->Axes)) - 1u; }
 };
 
 // The band's voxel faces with their Potts weights, and per voxel its faces to voxels outside the
@@ -393,6 +450,7 @@ struct Band
 struct BandFaces
 {
   std::vector<std::int64_t> A, B, OutFirst, OutVoxel;
+  std::vector<std::int32_t> OutElement; // each outside voxel's element (-1 none)
   std::vector<double> W, OutWeight;
 };
 
@@ -409,6 +467,7 @@ void BuildBandFaces(const Band& band, std::int64_t first, BandFaces& f)
   struct Part
   {
     std::vector<std::int64_t> A, B, OutVoxel;
+    std::vector<std::int32_t> OutElement;
     std::vector<double> W, OutWeight;
   };
   std::vector<Part> parts(chunks);
@@ -421,6 +480,7 @@ void BuildBandFaces(const Band& band, std::int64_t first, BandFaces& f)
     }
     f.W.clear();
     f.OutWeight.clear();
+    f.OutElement.clear();
     f.OutFirst.push_back(0);
   }
   f.OutFirst.resize(nb + 1, 0);
@@ -432,7 +492,7 @@ void BuildBandFaces(const Band& band, std::int64_t first, BandFaces& f)
       for (std::int64_t i = first + c * chunk; i < last; ++i)
       {
         const std::int64_t v = band.Voxel[i];
-        band.Neighbours(v, [&](std::int64_t u, bool) {
+        band.DomainNeighbours(i, [&](std::int64_t u, bool) {
           const std::int64_t j = band.Find(u);
           if (j >= first && j < i)
           {
@@ -443,6 +503,7 @@ void BuildBandFaces(const Band& band, std::int64_t first, BandFaces& f)
           if (j < 0)
           {
             part.OutVoxel.push_back(u);
+            part.OutElement.push_back((*p.Owner)[u]);
             part.OutWeight.push_back(w);
             ++f.OutFirst[i + 1];
             return;
@@ -469,6 +530,7 @@ void BuildBandFaces(const Band& band, std::int64_t first, BandFaces& f)
     f.B.insert(f.B.end(), part.B.begin(), part.B.end());
     f.W.insert(f.W.end(), part.W.begin(), part.W.end());
     f.OutVoxel.insert(f.OutVoxel.end(), part.OutVoxel.begin(), part.OutVoxel.end());
+    f.OutElement.insert(f.OutElement.end(), part.OutElement.begin(), part.OutElement.end());
     f.OutWeight.insert(f.OutWeight.end(), part.OutWeight.begin(), part.OutWeight.end());
   }
   std::partial_sum(f.OutFirst.begin() + first, f.OutFirst.end(), f.OutFirst.begin() + first);
@@ -491,7 +553,7 @@ void BandCosts(Band& band, const BandFaces& f, const std::vector<std::uint64_t>&
   p.Parallel((nb + chunk - 1) / chunk, 1, [&](std::int64_t c0, std::int64_t c1) {
     for (std::int64_t i = c0 * chunk; i < std::min(nb, c1 * chunk); ++i)
     {
-      const std::int64_t v = band.Voxel[i], e = (*p.Owner)[v];
+      const std::int64_t v = band.Voxel[i], e = band.Element[i];
       double* c = &cost[i * L];
       band.Around[i] = 0;
       if (band.IsHeld(i))
@@ -514,7 +576,7 @@ void BandCosts(Band& band, const BandFaces& f, const std::vector<std::uint64_t>&
         {
           continue; // a face into the domain since it grew (ExtendBandFaces)
         }
-        const std::uint8_t held = band.ElementLabel(f.OutVoxel[k]);
+        const std::uint8_t held = band.LabelOf(f.OutElement[k]);
         band.Around[i] |= held < 64 ? std::uint64_t(1) << held : 0;
         for (int l = 0; l < L; ++l)
         {
@@ -559,10 +621,7 @@ void VoxelConnectivity(const Band& band, const GraphEdges& edges, std::vector<st
   {
     // Fill Holes keeps every object piece.
     bool keep = band.IsHeld(i) || ((band.Around[i] >> x[i]) & 1u) || (x[i] != 0 && p.Connectivity == Connectivity::FillHoles);
-    if (!keep && x[i] == 0)
-    {
-      band.Neighbours(band.Voxel[i], [](std::int64_t, bool) {}, &keep);
-    }
+    keep = keep || (x[i] == 0 && band.OnBorder(i));
     anchored[find(i)] |= keep;
   }
   // Faces each loose piece shares with each other label.
@@ -581,7 +640,7 @@ void VoxelConnectivity(const Band& band, const GraphEdges& edges, std::vector<st
       shared.emplace_back();
       shared.back().fill(0);
     }
-    band.Neighbours(band.Voxel[i], [&](std::int64_t u, bool) {
+    band.DomainNeighbours(i, [&](std::int64_t u, bool) {
       const std::int64_t j = band.Find(u);
       const std::uint8_t other = j >= 0 ? x[j] : band.ElementLabel(u);
       shared[slot[r]][other] += other != x[i];
@@ -626,8 +685,10 @@ void LoneVoxelsAround(const Band& band, const std::vector<std::uint8_t>& x, std:
     const std::uint8_t before = band.Own[i];
     if (x[i] != before)
     {
-      band.Neighbours(band.Voxel[i], [&](std::int64_t u, bool) {
-        if (band.ElementLabel(u) == before && !band.Free(u))
+      band.DomainNeighbours(i, [&](std::int64_t u, bool) {
+        // Not refined and of the label left: a held voxel's label is at hand.
+        const std::int64_t j = band.Find(u);
+        if (j >= 0 ? band.IsHeld(j) && band.Own[j] == before : band.ElementLabel(u) == before)
         {
           halo.push_back(u);
         }
@@ -681,8 +742,30 @@ std::vector<double> ComponentChanges(const VoxelRefinementProblem& p, const Voxe
   std::vector<double> change(1 + *std::max_element(component.begin(), component.end()), 0.0);
   const FaceAdjacency& faces = *p.Mesh->SharedFaces();
   const auto inside = [&](std::int64_t e) { return bandElement[e] || (!p.Fixed.empty() && p.Fixed[e]); };
+  // The faces of the band and seed elements, in face order.
   std::vector<std::int64_t> local;
-  for (std::size_t f = 0; f < faces.A.size(); ++f)
+  const std::vector<std::int32_t>& faceOf = p.Mesh->ElementFaces();
+  if (!faceOf.empty())
+  {
+    const int vpc = p.Mesh->VerticesPerCell();
+    std::vector<std::uint8_t> mark(faces.A.size(), 0);
+    for (std::size_t e = 0; e < label.size(); ++e)
+    {
+      for (int k = 0; k < vpc && inside(static_cast<std::int64_t>(e)); ++k)
+      {
+        const std::int32_t f = faceOf[e * vpc + k];
+        mark[f >= 0 ? f : 0] |= f >= 0;
+      }
+    }
+    for (std::size_t f = 0; f < mark.size(); ++f)
+    {
+      if (mark[f])
+      {
+        local.push_back(static_cast<std::int64_t>(f));
+      }
+    }
+  }
+  for (std::size_t f = 0; f < faces.A.size() && faceOf.empty(); ++f)
   {
     if (inside(faces.A[f]) || inside(faces.B[f]))
     {
@@ -736,7 +819,8 @@ struct VoxelRefinementCache::State
   // count it was solved for; two labels: its max-flow graphs holding the last flow; more: the
   // expansion's memory, which keeps its rows of edges while the faces stay (FacesVersion).
   std::vector<std::int64_t> Domain;
-  std::vector<std::uint8_t> DomainElement;
+  std::vector<std::uint8_t> DomainElement, Sides;
+  std::vector<std::int32_t> Element;
   BandFaces Faces;
   std::uint64_t FacesVersion = 0;
   BinaryGraphs Binary;
@@ -765,6 +849,8 @@ void DropDomain(VoxelRefinementCache::State& st)
   }
   st.Domain.clear();
   st.DomainElement.clear();
+  st.Sides.clear();
+  st.Element.clear();
   st.Solved = false;
 }
 
@@ -822,6 +908,28 @@ void IndexDomain(VoxelRefinementCache::State& st, const ImageGeometry& g, std::i
   for (std::int64_t i = from; i < n; ++i)
   {
     st.Index[st.Domain[i] - st.IndexFirst] = static_cast<std::int32_t>(i);
+  }
+}
+
+// Each domain voxel's element and face neighbours on the grid from `from` on (bit 2 d for +axis d,
+// 2 d + 1 for -axis d): read once while the domain stays, not from the image-sized owner map and
+// the voxel's coordinates at every visit.
+void DescribeDomain(VoxelRefinementCache::State& st, const ImageGeometry& g, const VoxelOwnerMap& owner, std::int64_t from)
+{
+  const std::int64_t n = static_cast<std::int64_t>(st.Domain.size());
+  st.Sides.resize(n);
+  st.Element.resize(n);
+  for (std::int64_t i = from; i < n; ++i)
+  {
+    st.Element[i] = owner[st.Domain[i]];
+    const std::array<int, 3> ijk = g.Coordinates(st.Domain[i]);
+    unsigned sides = 0;
+    for (int d = 0; d < 3; ++d)
+    {
+      sides |= (ijk[d] + 1 < g.Dims[d] ? 1u : 0u) << (2 * d);
+      sides |= (ijk[d] > 0 ? 1u : 0u) << (2 * d + 1);
+    }
+    st.Sides[i] = static_cast<std::uint8_t>(sides);
   }
 }
 
@@ -941,8 +1049,10 @@ void RefineOnDomain(const VoxelRefinementProblem& p, const ProgressFunction& pro
     st.Domain = BandVoxels(*p.Mesh, *p.Owner, element, p.Parallel);
     st.DomainElement = std::move(element);
   }
-  IndexDomain(st, p.Mesh->Geometry(), inside ? static_cast<std::int64_t>(st.Domain.size()) : extend ? first : 0);
-  Band domain(p, st.Domain, st.Index, st.IndexFirst);
+  const std::int64_t fresh = inside ? static_cast<std::int64_t>(st.Domain.size()) : extend ? first : 0;
+  IndexDomain(st, p.Mesh->Geometry(), fresh);
+  DescribeDomain(st, p.Mesh->Geometry(), *p.Owner, fresh);
+  Band domain(p, st.Domain, st.Index, st.IndexFirst, st.Sides, st.Element);
   r.BandVoxels = domain.ReadElements(bandElement);
   const bool held = r.BandVoxels < domain.Size();
   if (!progress(0.2))
