@@ -318,6 +318,19 @@ std::vector<std::int64_t> BandVoxels(const SimplexMesh& mesh, const VoxelOwnerMa
   return voxels;
 }
 
+// Which face neighbours voxel v has on the grid: bit 2 d for +axis d, 2 d + 1 for -axis d.
+unsigned GridSides(const ImageGeometry& g, std::int64_t v)
+{
+  const std::array<int, 3> ijk = g.Coordinates(v);
+  unsigned sides = 0;
+  for (int d = 0; d < 3; ++d)
+  {
+    sides |= (ijk[d] + 1 < g.Dims[d] ? 1u : 0u) << (2 * d);
+    sides |= (ijk[d] > 0 ? 1u : 0u) << (2 * d + 1);
+  }
+  return sides;
+}
+
 // The kept domain's voxels and what lies around them: the band's voxels, and those held at their
 // elements' labels (Held).
 struct Band
@@ -328,7 +341,7 @@ struct Band
   std::vector<std::uint64_t> Around; // per voxel: the labels of its neighbours outside the domain (bit l, l < 64)
   const std::vector<std::int32_t>& Index; // the domain's index map (State::Index), from voxel IndexFirst on
   std::int64_t IndexFirst;
-  const std::vector<std::uint8_t>& Sides;  // per voxel: its face neighbours on the grid (DescribeDomain)
+  const std::vector<std::uint8_t>& Sides;  // per voxel: its GridSides (DescribeDomain)
   const std::vector<std::int32_t>& Element; // per voxel: its element (-1 none)
   std::vector<std::uint8_t> Held, Own;    // per voxel: held, and its element's label (ReadElements)
   std::int64_t Stride[3];
@@ -393,34 +406,18 @@ struct Band
   template <typename F>
   void Neighbours(std::int64_t v, F&& f, bool* border = nullptr) const
   {
-    const std::array<int, 3> ijk = this->G.Coordinates(v);
-    for (int d = 0; d < this->Axes; ++d)
-    {
-      if (ijk[d] + 1 < this->G.Dims[d])
-      {
-        f(v + this->Stride[d], true);
-      }
-      else if (border)
-      {
-        *border = true;
-      }
-      if (ijk[d] > 0)
-      {
-        f(v - this->Stride[d], false);
-      }
-      else if (border)
-      {
-        *border = true;
-      }
-    }
+    this->VisitSides(v, GridSides(this->G, v), f, border);
   }
-
   // Neighbours() of the domain's voxel i, from its Sides instead of its coordinates.
   template <typename F>
   void DomainNeighbours(std::int64_t i, F&& f, bool* border = nullptr) const
   {
-    const std::int64_t v = this->Voxel[i];
-    const unsigned sides = this->Sides[i];
+    this->VisitSides(this->Voxel[i], this->Sides[i], f, border);
+  }
+  // f(u, forward) for the face neighbours of voxel v that `sides` (GridSides) names.
+  template <typename F>
+  void VisitSides(std::int64_t v, unsigned sides, F& f, bool* border) const
+  {
     for (int d = 0; d < this->Axes; ++d)
     {
       if ((sides >> (2 * d)) & 1u)
@@ -911,9 +908,8 @@ void IndexDomain(VoxelRefinementCache::State& st, const ImageGeometry& g, std::i
   }
 }
 
-// Each domain voxel's element and face neighbours on the grid from `from` on (bit 2 d for +axis d,
-// 2 d + 1 for -axis d): read once while the domain stays, not from the image-sized owner map and
-// the voxel's coordinates at every visit.
+// Each domain voxel's element and GridSides from `from` on: read once while the domain stays, not
+// from the image-sized owner map and the voxel's coordinates at every visit.
 void DescribeDomain(VoxelRefinementCache::State& st, const ImageGeometry& g, const VoxelOwnerMap& owner, std::int64_t from)
 {
   const std::int64_t n = static_cast<std::int64_t>(st.Domain.size());
@@ -922,14 +918,7 @@ void DescribeDomain(VoxelRefinementCache::State& st, const ImageGeometry& g, con
   for (std::int64_t i = from; i < n; ++i)
   {
     st.Element[i] = owner[st.Domain[i]];
-    const std::array<int, 3> ijk = g.Coordinates(st.Domain[i]);
-    unsigned sides = 0;
-    for (int d = 0; d < 3; ++d)
-    {
-      sides |= (ijk[d] + 1 < g.Dims[d] ? 1u : 0u) << (2 * d);
-      sides |= (ijk[d] > 0 ? 1u : 0u) << (2 * d + 1);
-    }
-    st.Sides[i] = static_cast<std::uint8_t>(sides);
+    st.Sides[i] = static_cast<std::uint8_t>(GridSides(g, st.Domain[i]));
   }
 }
 
