@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 #include <numeric>
+#include <stdexcept>
 
 namespace featuremesh
 {
@@ -364,12 +365,12 @@ const std::vector<std::int32_t>& SimplexMesh::ElementFaces() const
   std::lock_guard<std::mutex> lock(this->Cached->Lock);
   if (!this->Cached->ElementFaces)
   {
-    auto table = std::make_shared<std::vector<std::int32_t>>();
-    if (faces.A.size() <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+    if (faces.A.size() > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
     {
-      table->assign(static_cast<std::size_t>(this->NumberOfElements() * this->Vpc), -1);
+      throw std::length_error("the mesh has more faces than 32-bit face ids hold.");
     }
-    for (std::size_t f = 0; f < faces.A.size() && !table->empty(); ++f)
+    auto table = std::make_shared<std::vector<std::int32_t>>(static_cast<std::size_t>(this->NumberOfElements() * this->Vpc), -1);
+    for (std::size_t f = 0; f < faces.A.size(); ++f)
     {
       (*table)[faces.A[f] * this->Vpc + faces.LocalA[f]] = static_cast<std::int32_t>(f);
       (*table)[faces.B[f] * this->Vpc + faces.LocalB[f]] = static_cast<std::int32_t>(f);
@@ -556,10 +557,11 @@ std::vector<std::int64_t> LabelBoundaryFaces(const SimplexMesh& mesh, const Face
   std::vector<std::pair<std::int64_t, int>> inner, hull;
   const int vpc = mesh.VerticesPerCell();
   // Every face between two labels has an end of a label other than 0: the faces of those elements
-  // (most of a mesh is background), each face from the end it is listed by.
-  static const std::vector<std::int32_t> unlisted;
-  const std::vector<std::int32_t>& faceOf = &adjacency == &mesh.Faces() ? mesh.ElementFaces() : unlisted;
-  for (std::size_t e = 0; e < label.size() && !faceOf.empty(); ++e)
+  // (most of a mesh is background), each face from the end it is listed by. Another adjacency than
+  // the mesh's own is walked whole.
+  const bool own = &adjacency == &mesh.Faces();
+  const std::vector<std::int32_t>& faceOf = mesh.ElementFaces();
+  for (std::size_t e = 0; e < label.size() && own; ++e)
   {
     for (int k = 0; k < vpc && label[e]; ++k)
     {
@@ -575,7 +577,7 @@ std::vector<std::int64_t> LabelBoundaryFaces(const SimplexMesh& mesh, const Face
       }
     }
   }
-  for (std::size_t i = 0; i < adjacency.A.size() && faceOf.empty(); ++i)
+  for (std::size_t i = 0; i < adjacency.A.size() && !own; ++i)
   {
     const std::int64_t a = adjacency.A[i], b = adjacency.B[i];
     if (label[a] != label[b])

@@ -80,8 +80,9 @@ public:
   const CompressedRows& Stars() const;
   const CompressedRows& VertexNeighbours() const;
   // Per element and local face (elements x VerticesPerCell()): the index of the interior face in
-  // Faces(), -1 on the hull; empty beyond 2^31 faces. Built on first use from Faces(): the faces of
-  // a few elements without a pass over every face.
+  // Faces(), -1 on the hull. Built on first use from Faces(): the faces of a few elements without a
+  // pass over every face. Throws std::length_error beyond 2^31 - 1 faces (the cuts' max-flow ids
+  // stop at 10^9 faces, GraphSizeProblem).
   const std::vector<std::int32_t>& ElementFaces() const;
 
 private:

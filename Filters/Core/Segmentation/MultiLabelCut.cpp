@@ -711,16 +711,10 @@ std::int64_t ApplyLabelConnectivity(Connectivity mode, std::vector<std::uint8_t>
   LabelComponentsOf own;
   LabelComponentsOf& given = components ? *components : own;
   KeepLabelComponents(label, edges, given);
-  std::int64_t count = given.Count;
   const std::vector<std::int64_t>& edge = given.Between; // (p, q, e) of the edges between labels
-  // The components as given, or a copy joined through the contacts.
+  std::int64_t count = 0;
   std::vector<std::int64_t> joinedId;
-  if (contacts.Size() > 0)
-  {
-    joinedId = given.Id;
-    JoinContacts(label, contacts, joinedId, count);
-  }
-  const std::vector<std::int64_t>& comp = contacts.Size() > 0 ? joinedId : given.Id;
+  const std::vector<std::int64_t>& comp = ComponentIds(label, contacts, given, joinedId, count);
   std::vector<std::int64_t> root(count), size(count, 0);
   std::iota(root.begin(), root.end(), std::int64_t(0));
   std::vector<std::uint8_t> group(count, 0), seeded(count, 0), touches(count, 0);

@@ -136,6 +136,19 @@ void JoinContacts(const std::vector<std::uint8_t>& label, const GraphEdges& cont
   count = next;
 }
 
+const std::vector<std::int64_t>& ComponentIds(const std::vector<std::uint8_t>& label, const GraphEdges& contacts,
+  const LabelComponentsOf& components, std::vector<std::int64_t>& joined, std::int64_t& count)
+{
+  count = components.Count;
+  if (contacts.Size() == 0)
+  {
+    return components.Id;
+  }
+  joined = components.Id;
+  JoinContacts(label, contacts, joined, count);
+  return joined;
+}
+
 std::int64_t ApplyWithContacts(std::vector<std::uint8_t>& label, const ContactsFunction& contactsOf, const ContactsRule& apply)
 {
   const std::vector<std::uint8_t> given = label;
@@ -198,15 +211,9 @@ std::int64_t ApplyConnectivity(Connectivity mode, std::vector<std::uint8_t>& lab
   {
     return -1;
   }
-  std::int64_t count = given.Count;
-  // The components as given, or a copy joined through the contacts.
+  std::int64_t count = 0;
   std::vector<std::int64_t> joinedId;
-  if (contacts.Size() > 0)
-  {
-    joinedId = given.Id;
-    JoinContacts(label, contacts, joinedId, count);
-  }
-  const std::vector<std::int64_t>& id = contacts.Size() > 0 ? joinedId : given.Id;
+  const std::vector<std::int64_t>& id = ComponentIds(label, contacts, given, joinedId, count);
   const std::vector<std::int64_t>& between = given.Between;
   const bool rules = mode != Connectivity::Off;
   std::vector<std::uint8_t> value(count, 0), objectSeed(count, 0), anchored(count, 0);

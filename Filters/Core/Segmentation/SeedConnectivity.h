@@ -67,6 +67,12 @@ bool KeepLabelComponents(const std::vector<std::uint8_t>& label, const GraphEdge
 void JoinContacts(const std::vector<std::uint8_t>& label, const GraphEdges& contacts, std::vector<std::int64_t>& id,
   std::int64_t& count);
 
+// Each node's component: `components`' ids as they are when no contact is given (`count` their
+// number), else a copy in `joined` with the contacts' components joined (JoinContacts; `count`
+// updated).
+const std::vector<std::int64_t>& ComponentIds(const std::vector<std::uint8_t>& label, const GraphEdges& contacts,
+  const LabelComponentsOf& components, std::vector<std::int64_t>& joined, std::int64_t& count);
+
 // The contacts (node pairs, as JoinContacts takes them) of the given nodes.
 using ContactsFunction = std::function<GraphEdges(const std::vector<std::int64_t>& nodes)>;
 

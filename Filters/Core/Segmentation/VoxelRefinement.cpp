@@ -191,14 +191,13 @@ void BandElements(const VoxelRefinementProblem& p, const FaceAdjacency& faces, s
 {
   const std::vector<std::uint8_t>& label = *p.Label;
   const std::int64_t n = static_cast<std::int64_t>(label.size());
-  const std::int64_t m = static_cast<std::int64_t>(faces.A.size());
   band.assign(n, 0);
-  // Through the elements' own faces when the mesh lists them: every face between two labels has an
-  // end of a label other than 0, and each ring adds the band's face neighbours.
+  // Through the elements' own faces: every face between two labels has an end of a label other
+  // than 0, and each ring adds the band's face neighbours.
   const std::vector<std::int32_t>& faceOf = p.Mesh->ElementFaces();
   const int vpc = p.Mesh->VerticesPerCell();
   const auto other = [&](std::int64_t e, std::int32_t f) { return faces.A[f] == e ? faces.B[f] : faces.A[f]; };
-  for (std::int64_t e = 0; e < n && !faceOf.empty(); ++e)
+  for (std::int64_t e = 0; e < n; ++e)
   {
     for (int k = 0; k < vpc && label[e]; ++k)
     {
@@ -209,17 +208,10 @@ void BandElements(const VoxelRefinementProblem& p, const FaceAdjacency& faces, s
       }
     }
   }
-  for (std::int64_t f = 0; f < m && faceOf.empty(); ++f)
-  {
-    if (label[faces.A[f]] != label[faces.B[f]])
-    {
-      band[faces.A[f]] = band[faces.B[f]] = 1;
-    }
-  }
   for (int r = 1; r < p.Rings; ++r)
   {
     std::vector<std::uint8_t> grown = band;
-    for (std::int64_t e = 0; e < n && !faceOf.empty(); ++e)
+    for (std::int64_t e = 0; e < n; ++e)
     {
       for (int k = 0; k < vpc && band[e]; ++k)
       {
@@ -229,11 +221,6 @@ void BandElements(const VoxelRefinementProblem& p, const FaceAdjacency& faces, s
           grown[other(e, f)] = 1;
         }
       }
-    }
-    for (std::int64_t f = 0; f < m && faceOf.empty(); ++f)
-    {
-      grown[faces.A[f]] |= band[faces.B[f]];
-      grown[faces.B[f]] |= band[faces.A[f]];
     }
     band.swap(grown);
   }
@@ -258,7 +245,7 @@ void BandElements(const VoxelRefinementProblem& p, const FaceAdjacency& faces, s
   for (int r = 0; r < p.Rings; ++r)
   {
     std::vector<std::uint64_t> grown = near;
-    for (std::int64_t f = 0; f < m; ++f)
+    for (std::size_t f = 0; f < faces.A.size(); ++f)
     {
       grown[faces.A[f]] |= near[faces.B[f]];
       grown[faces.B[f]] |= near[faces.A[f]];
@@ -396,12 +383,6 @@ struct Band
     return k < this->Index.size() ? this->Index[k] : -1;
   }
   bool IsHeld(std::int64_t i) const { return this->Held[i] != 0; }
-  // Whether voxel u is refined (in the band, not held).
-  bool Free(std::int64_t u) const
-  {
-    const std::int64_t j = this->Find(u);
-    return j >= 0 && !this->IsHeld(j);
-  }
   // f(u, forward) for every face neighbour u of voxel v; `border` is set when v lies on the image's border.
   template <typename F>
   void Neighbours(std::int64_t v, F&& f, bool* border = nullptr) const
@@ -742,29 +723,21 @@ std::vector<double> ComponentChanges(const VoxelRefinementProblem& p, const Voxe
   // The faces of the band and seed elements, in face order.
   std::vector<std::int64_t> local;
   const std::vector<std::int32_t>& faceOf = p.Mesh->ElementFaces();
-  if (!faceOf.empty())
+  const int vpc = p.Mesh->VerticesPerCell();
+  std::vector<std::uint8_t> mark(faces.A.size(), 0);
+  for (std::size_t e = 0; e < label.size(); ++e)
   {
-    const int vpc = p.Mesh->VerticesPerCell();
-    std::vector<std::uint8_t> mark(faces.A.size(), 0);
-    for (std::size_t e = 0; e < label.size(); ++e)
+    for (int k = 0; k < vpc && inside(static_cast<std::int64_t>(e)); ++k)
     {
-      for (int k = 0; k < vpc && inside(static_cast<std::int64_t>(e)); ++k)
+      if (faceOf[e * vpc + k] >= 0)
       {
-        const std::int32_t f = faceOf[e * vpc + k];
-        mark[f >= 0 ? f : 0] |= f >= 0;
-      }
-    }
-    for (std::size_t f = 0; f < mark.size(); ++f)
-    {
-      if (mark[f])
-      {
-        local.push_back(static_cast<std::int64_t>(f));
+        mark[faceOf[e * vpc + k]] = 1;
       }
     }
   }
-  for (std::size_t f = 0; f < faces.A.size() && faceOf.empty(); ++f)
+  for (std::size_t f = 0; f < mark.size(); ++f)
   {
-    if (inside(faces.A[f]) || inside(faces.B[f]))
+    if (mark[f])
     {
       local.push_back(static_cast<std::int64_t>(f));
     }
