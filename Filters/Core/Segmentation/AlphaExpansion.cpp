@@ -44,7 +44,17 @@ void ForNodeBlocks(const PottsProblem& pr, const ParallelFor& parallel, F&& f)
     [&](std::int64_t b) { f(b, b * NodeBlock, std::min(pr.Nodes, (b + 1) * NodeBlock)); });
 }
 
-std::string Validate(const PottsProblem& pr, const ParallelFor& parallel)
+std::int16_t HardLabel(const PottsProblem& pr, std::int64_t p)
+{
+  return pr.Hard.empty() ? -1 : pr.Hard[p];
+}
+
+// The moves' start: checks every input (finite costs and weights, hard labels in range, edges
+// naming nodes) and, in the same passes over the node and the edge blocks, sets the start labels
+// (`label` when it has one per node, a kept result, else each node's cheapest; hard nodes their
+// own, a label out of range 0) and sums their energy as PottsEnergy does. Costs and weights of at
+// most 1e150 on at most GraphSizeProblem's nodes and edges keep every energy far below overflow.
+std::string Start(const PottsProblem& pr, std::vector<std::uint8_t>& label, const ParallelFor& parallel, double& energy)
 {
   if (pr.Labels < 2 || pr.Labels > 256)
   {
@@ -64,28 +74,59 @@ std::string Validate(const PottsProblem& pr, const ParallelFor& parallel)
   {
     return "the costs, weights or hard labels do not match the graph.";
   }
+  const int L = pr.Labels;
+  const bool cheapest = static_cast<std::int64_t>(label.size()) != pr.Nodes;
+  if (cheapest)
+  {
+    label.resize(pr.Nodes);
+  }
   enum : std::uint8_t { BadCost = 1, BadWeight = 2, BadHard = 4, BadEnd = 8 };
   std::vector<std::uint8_t> nodeBad(NodeBlocks(pr), 0), edgeBad(pr.Edges->Blocks(), 0);
-  // Each block's flags in a local, stored once: neighbouring flags share a cache line.
+  std::vector<double> nodeSum(nodeBad.size(), 0.0), edgeSum(edgeBad.size(), 0.0);
+  // Each block's flags and sum in locals, stored once: neighbouring ones share a cache line.
   ForNodeBlocks(pr, parallel, [&](std::int64_t b, std::int64_t p0, std::int64_t p1) {
     bool cost = false, hard = false;
-    for (std::int64_t i = p0 * pr.Labels; i < p1 * pr.Labels; ++i)
+    for (std::int64_t i = p0 * L; i < p1 * L; ++i)
     {
       cost = cost || !(std::fabs(pr.Cost[i]) <= 1e150);
     }
     for (std::int64_t p = p0; p < p1 && !pr.Hard.empty(); ++p)
     {
-      hard = hard || pr.Hard[p] < -1 || pr.Hard[p] >= pr.Labels;
+      hard = hard || pr.Hard[p] < -1 || pr.Hard[p] >= L;
     }
     nodeBad[b] = (cost ? BadCost : 0) | (hard ? BadHard : 0);
+    if (cost || hard)
+    {
+      return;
+    }
+    double sum = 0.0;
+    for (std::int64_t p = p0; p < p1; ++p)
+    {
+      const std::int16_t h = HardLabel(pr, p);
+      const double* c = &pr.Cost[p * L];
+      if (cheapest)
+      {
+        label[p] = static_cast<std::uint8_t>(h >= 0 ? h : std::min_element(c, c + L) - c);
+      }
+      if (label[p] >= L || (h >= 0 && label[p] != h))
+      {
+        label[p] = static_cast<std::uint8_t>(h >= 0 ? h : 0);
+      }
+      sum += c[label[p]];
+    }
+    nodeSum[b] = sum;
   });
   ForBlocks(parallel, pr.Edges->Blocks(), [&](std::int64_t b) {
     bool weight = false, end = false;
+    double sum = 0.0;
     pr.Edges->ForEach(b, b + 1, [&](std::int64_t e, std::int64_t a, std::int64_t c) {
       weight = weight || !(pr.Weight[e] >= 0.0 && pr.Weight[e] <= 1e150);
-      end = end || a < 0 || c < 0 || a >= pr.Nodes || c >= pr.Nodes;
+      const bool inside = a >= 0 && c >= 0 && a < pr.Nodes && c < pr.Nodes;
+      end = end || !inside;
+      sum += inside && label[a] != label[c] ? pr.Weight[e] : 0.0;
     });
     edgeBad[b] = (weight ? BadWeight : 0) | (end ? BadEnd : 0);
+    edgeSum[b] = sum;
   });
   std::uint8_t bad = 0;
   for (std::uint8_t f : nodeBad)
@@ -95,6 +136,15 @@ std::string Validate(const PottsProblem& pr, const ParallelFor& parallel)
   for (std::uint8_t f : edgeBad)
   {
     bad |= f;
+  }
+  energy = 0.0;
+  for (double e : nodeSum)
+  {
+    energy += e;
+  }
+  for (double e : edgeSum)
+  {
+    energy += e;
   }
   return bad & BadCost ? "a label cost is not finite; check the image for NaN or infinite values."
     : bad & BadWeight  ? "a boundary weight is negative or not finite."
@@ -136,61 +186,6 @@ double PottsEnergy(const PottsProblem& pr, const std::vector<std::uint8_t>& labe
 
 namespace
 {
-std::int16_t HardLabel(const PottsProblem& pr, std::int64_t p)
-{
-  return pr.Hard.empty() ? -1 : pr.Hard[p];
-}
-
-// The labelling the moves start from: `label` when it has one label per node (a kept result), else
-// each node's cheapest label; hard nodes take their own, a label out of range 0.
-void StartLabels(const PottsProblem& pr, std::vector<std::uint8_t>& label)
-{
-  const std::int64_t n = pr.Nodes;
-  const int L = pr.Labels;
-  if (static_cast<std::int64_t>(label.size()) != n)
-  {
-    label.assign(n, 0);
-    for (std::int64_t p = 0; p < n; ++p)
-    {
-      const double* c = &pr.Cost[p * L];
-      label[p] = static_cast<std::uint8_t>(HardLabel(pr, p) >= 0 ? HardLabel(pr, p) : std::min_element(c, c + L) - c);
-    }
-  }
-  for (std::int64_t p = 0; p < n; ++p)
-  {
-    const std::int16_t h = HardLabel(pr, p);
-    if (label[p] >= L || (h >= 0 && label[p] != h))
-    {
-      label[p] = static_cast<std::uint8_t>(h >= 0 ? h : 0);
-    }
-  }
-}
-
-// A bound on the energy of any labelling: finite costs and weights whose sum overflows are an error.
-double EnergyBound(const PottsProblem& pr, const ParallelFor& parallel)
-{
-  std::vector<double> sum(NodeBlocks(pr), 0.0);
-  ForNodeBlocks(pr, parallel, [&](std::int64_t b, std::int64_t p0, std::int64_t p1) {
-    double s = 0.0;
-    for (std::int64_t p = p0; p < p1; ++p)
-    {
-      const double* c = &pr.Cost[p * pr.Labels];
-      s += std::fabs(*std::max_element(c, c + pr.Labels)) + std::fabs(*std::min_element(c, c + pr.Labels));
-    }
-    sum[b] = s;
-  });
-  double K = 1.0;
-  for (double s : sum)
-  {
-    K += s;
-  }
-  for (double w : pr.Weight)
-  {
-    K += w;
-  }
-  return K;
-}
-
 // v sized n; grown, its capacity half again as large: a graph that grows a little from one call to
 // the next (a voxel band's kept domain) keeps its arrays and their pages, not fresh ones each time.
 template <typename T>
@@ -206,10 +201,13 @@ void ResizeWithRoom(std::vector<T>& v, std::size_t n)
 // Each node's summed boundary weight (Reach: the most a move's pairwise terms can reward it for
 // switching), and its neighbours with the edges' weights in compressed rows (First), to price a
 // move by the nodes it moved. Side: 2 e when the node is edge e's first end, 2 e + 1 its second.
+// Neighbours and sides in 32 bits (GraphSizeProblem keeps nodes and 2 x edges below 2^31): the
+// moves stream these rows, and they are most of what a move reads.
 struct Neighbourhood
 {
   std::vector<double> Reach, Weight;
-  std::vector<std::int64_t> First, Neighbour, Side;
+  std::vector<std::int64_t> First;
+  std::vector<std::int32_t> Neighbour, Side;
   // Whether the edges come in ascending order of their first ends (a voxel band's faces): then a
   // node's first-end entries, in the order of the nodes, are the edges in their own order.
   bool FirstEndsAscending = false;
@@ -242,11 +240,11 @@ struct Neighbourhood
     ResizeWithRoom(this->Side, this->First[n]);
     std::vector<std::int64_t> at(this->First.begin(), this->First.end() - 1);
     pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
-      this->Side[at[p]] = 2 * k;
-      this->Neighbour[at[p]] = q;
+      this->Side[at[p]] = static_cast<std::int32_t>(2 * k);
+      this->Neighbour[at[p]] = static_cast<std::int32_t>(q);
       this->Weight[at[p]++] = pr.Weight[k];
-      this->Side[at[q]] = 2 * k + 1;
-      this->Neighbour[at[q]] = p;
+      this->Side[at[q]] = static_cast<std::int32_t>(2 * k + 1);
+      this->Neighbour[at[q]] = static_cast<std::int32_t>(p);
       this->Weight[at[q]++] = pr.Weight[k];
     });
   }
@@ -785,21 +783,15 @@ ExpansionResult AlphaExpansion(const PottsProblem& pr, std::vector<std::uint8_t>
   int maxCycles, RecycledMoves* recycled, const ParallelFor& parallel, ExpansionWorkspace* workspace)
 {
   ExpansionResult r;
-  r.Error = Validate(pr, parallel);
+  double energy = 0.0;
+  r.Error = Start(pr, label, parallel, energy);
   if (!r.Error.empty())
   {
     return r;
   }
   const std::int64_t n = pr.Nodes;
   const int L = pr.Labels;
-  StartLabels(pr, label);
-  if (!std::isfinite(EnergyBound(pr, parallel)))
-  {
-    r.Error = "the energy overflows (lambda or the graph are too large); lower lambda.";
-    return r;
-  }
   const std::int64_t m = pr.Edges->Size();
-  double energy = PottsEnergy(pr, label, parallel);
   try
   {
     RecycledMoves::State* kept = recycled ? SyncRecycled(*recycled, pr, label, parallel) : nullptr;

@@ -1,6 +1,8 @@
 #include "SeedReach.h"
 #include "SimplexMesh.h"
 
+#include <Eigen/Core>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -153,13 +155,14 @@ bool SeedReachCosts(const NodeCentres& nodes, const std::vector<std::int64_t>& s
   constexpr std::int64_t Block = 512;
   parallel(n, 16384, [&](std::int64_t p0, std::int64_t p1) {
     std::array<std::array<double, Block>, 3> x;
-    std::array<double, Block> d2;
+    std::array<double, Block> d2, beyond;
     for (std::int64_t b = p0; b < p1; b += Block)
     {
       const std::int64_t m = std::min(Block, p1 - b);
+      const Point* centre = nodes.Centre.empty() ? nullptr : nodes.Centre.data() + b;
       for (std::int64_t i = 0; i < m; ++i)
       {
-        const Point c = nodes(b + i);
+        const Point c = centre ? centre[i] : nodes(b + i);
         x[0][i] = c[0];
         x[1][i] = c[1];
         x[2][i] = c[2];
@@ -177,9 +180,22 @@ bool SeedReachCosts(const NodeCentres& nodes, const std::vector<std::int64_t>& s
             d2[i] = std::min(d2[i], d);
           }
         }
+        if (!(R[l] > 0.0))
+        {
+          for (std::int64_t i = 0; i < m; ++i)
+          {
+            cost[(b + i) * objects + l - 1] = 0.0;
+          }
+          continue;
+        }
+        // Every node's term in vector registers (std::sqrt's errno keeps GCC's loop scalar), then kept
+        // beyond the reach only.
+        const Eigen::Map<const Eigen::ArrayXd> d(d2.data(), m);
+        Eigen::Map<Eigen::ArrayXd>(beyond.data(), m) =
+          (d > free2).select(p.Weight * (d.sqrt() / R[l] - p.Reach), Eigen::ArrayXd::Zero(m));
         for (std::int64_t i = 0; i < m; ++i)
         {
-          cost[(b + i) * objects + l - 1] = R[l] > 0.0 && d2[i] > free2 ? p.Weight * (std::sqrt(d2[i]) / R[l] - p.Reach) : 0.0;
+          cost[(b + i) * objects + l - 1] = beyond[i];
         }
       }
     }
