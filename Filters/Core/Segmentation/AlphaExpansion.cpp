@@ -634,18 +634,15 @@ double RecycledMove(const PottsProblem& pr, int alpha, const std::vector<std::ui
   {
     if (!lg.G)
     {
+      // In small pages: on the 2-core VMs, advised huge pages made a first cut's graphs (~45 MB a
+      // label on BraTS) take 0.3-0.5 s each to touch in half the runs (docs/benchmark.md).
       lg.G.reset(new Flow(static_cast<int>(n), static_cast<int>(m), ThrowOutOfMemory));
       lg.Changed.reset(new maxflow::Block<int>(4096));
-      // The arcs, most of a graph's memory, are first touched below.
-      AdviseHugePages(lg.G->get_first_arc(), static_cast<std::size_t>(2 * m) * sizeof(*lg.G->get_first_arc()));
     }
     Flow& g = *lg.G;
     g.reset();
     g.add_node(static_cast<int>(n));
-    if (lg.Cap.size() != static_cast<std::size_t>(2 * m))
-    {
-      AssignFresh(lg.Cap, static_cast<std::size_t>(2 * m));
-    }
+    lg.Cap.resize(static_cast<std::size_t>(2 * m));
     pr.Edges->ForEach([&](std::int64_t k, std::int64_t p, std::int64_t q) {
       capacities(p, q, pr.Weight[k], lg.Cap[2 * k], lg.Cap[2 * k + 1]);
       g.add_edge(static_cast<int>(p), static_cast<int>(q), lg.Cap[2 * k], lg.Cap[2 * k + 1]);
