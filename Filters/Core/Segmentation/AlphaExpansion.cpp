@@ -284,7 +284,7 @@ double MoveChange(const PottsProblem& pr, int alpha, const std::vector<std::uint
 struct MoveBuffers
 {
   std::vector<double> Keep, Take; // by id in the move's graph
-  std::vector<std::int32_t> Id;   // a node's id in the move's graph, -1 when it is fixed
+  std::vector<std::int32_t> Id;   // a node's id in the move's graph, -1 when fixed (after the flow: or kept)
   std::vector<std::int64_t> Free; // the free nodes in ascending order: Free[Id[p]] == p
 };
 double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::uint8_t>& label, const Neighbourhood& around,
@@ -393,15 +393,19 @@ double ExpansionMove(const PottsProblem& pr, int alpha, const std::vector<std::u
     g.add_tweights(x, take[x] - low, keep[x] - low);
   }
   g.maxflow();
+  // The switched nodes keep their ids, the others drop theirs: MoveChange then asks no segments.
   for (std::int32_t x = 0; x < active; ++x)
   {
     if (g.what_segment(x) == Flow::SINK)
     {
       switched.push_back(freeNodes[x]);
     }
+    else
+    {
+      id[freeNodes[x]] = -1;
+    }
   }
-  return MoveChange(pr, alpha, label, around, switched,
-    [&](std::int64_t q) { return id[q] >= 0 && g.what_segment(id[q]) == Flow::SINK; });
+  return MoveChange(pr, alpha, label, around, switched, [&](std::int64_t q) { return id[q] >= 0; });
 }
 
 // A label's kept move graph: every node and edge, with the labels, terminal terms (take - keep) and
