@@ -1,6 +1,5 @@
 #include "AlphaExpansion.h"
 #include "FlowGraph.h"
-#include "Memory.h"
 
 #include <algorithm>
 #include <cmath>

@@ -169,6 +169,14 @@ bool SeedReachCosts(const NodeCentres& nodes, const std::vector<std::int64_t>& s
       }
       for (int l = 1; l < labels; ++l)
       {
+        if (!(R[l] > 0.0))
+        {
+          for (std::int64_t i = 0; i < m; ++i)
+          {
+            cost[(b + i) * objects + l - 1] = 0.0;
+          }
+          continue;
+        }
         const double free2 = (p.Reach * R[l]) * (p.Reach * R[l]);
         std::fill(d2.begin(), d2.begin() + m, std::numeric_limits<double>::infinity());
         for (const Point& s : near[l])
@@ -180,19 +188,11 @@ bool SeedReachCosts(const NodeCentres& nodes, const std::vector<std::int64_t>& s
             d2[i] = std::min(d2[i], d);
           }
         }
-        if (!(R[l] > 0.0))
-        {
-          for (std::int64_t i = 0; i < m; ++i)
-          {
-            cost[(b + i) * objects + l - 1] = 0.0;
-          }
-          continue;
-        }
         // Every node's term in vector registers (std::sqrt's errno keeps GCC's loop scalar), then kept
         // beyond the reach only.
         const Eigen::Map<const Eigen::ArrayXd> d(d2.data(), m);
         Eigen::Map<Eigen::ArrayXd>(beyond.data(), m) =
-          (d > free2).select(p.Weight * (d.sqrt() / R[l] - p.Reach), Eigen::ArrayXd::Zero(m));
+          (d > free2).select(p.Weight * (d.sqrt() / R[l] - p.Reach), 0.0);
         for (std::int64_t i = 0; i < m; ++i)
         {
           cost[(b + i) * objects + l - 1] = beyond[i];
