@@ -378,6 +378,20 @@ TEST(AlphaExpansion, BadProblemsAreErrors)
   EXPECT_FALSE(AlphaExpansion(pr, {}).Error.empty());
   pr.Labels = 1;
   EXPECT_FALSE(AlphaExpansion(pr, {}).Error.empty());
+  // The checks share their passes with the start's energy: an edge to a node beyond the graph and a
+  // cost beyond the bound are errors, not reads out of range or an overflow.
+  const GraphEdges beyond = GraphEdges::Owned({ 0, 1, 2 }, { 1, 7, 3 });
+  PottsProblem far;
+  far.Nodes = 4;
+  far.Labels = 2;
+  far.Edges = &beyond;
+  far.Weight.assign(3, 1.0);
+  far.Cost.assign(8, 0.0);
+  EXPECT_NE(AlphaExpansion(far, { 0, 1, 0, 1 }).Error.find("outside the graph"), std::string::npos);
+  far.Edges = &edges;
+  far.Weight.assign(edges.Size(), 1.0);
+  far.Cost[5] = 1e200;
+  EXPECT_NE(AlphaExpansion(far, {}).Error.find("not finite"), std::string::npos);
 }
 
 TEST(MultiLabel, ThreePlateausAreTheLabelsOnVoxelsAndElements)
