@@ -559,30 +559,39 @@ std::vector<std::int64_t> LabelBoundaryFaces(const SimplexMesh& mesh, const Face
   // Every face between two labels has an end of a label other than 0: the faces of those elements
   // (most of a mesh is background), each face from the end it is listed by. Another adjacency than
   // the mesh's own is walked whole.
-  const bool own = &adjacency == &mesh.Faces();
-  const std::vector<std::int32_t>& faceOf = mesh.ElementFaces();
-  for (std::size_t e = 0; e < label.size() && own; ++e)
+  if (&adjacency == &mesh.Faces())
   {
-    for (int k = 0; k < vpc && label[e]; ++k)
+    const std::vector<std::int32_t>& faceOf = mesh.ElementFaces();
+    for (std::size_t e = 0; e < label.size(); ++e)
     {
-      const std::int32_t i = faceOf[e * vpc + k];
-      if (i < 0)
+      if (!label[e])
       {
         continue;
       }
-      const std::int64_t a = adjacency.A[i], b = adjacency.B[i];
-      if (label[a] != label[b] && static_cast<std::int64_t>(e) == (label[a] ? a : b))
+      for (int k = 0; k < vpc; ++k)
       {
-        inner.emplace_back(e, k);
+        const std::int32_t i = faceOf[e * vpc + k];
+        if (i < 0)
+        {
+          continue;
+        }
+        const std::int64_t a = adjacency.A[i], b = adjacency.B[i];
+        if (label[a] != label[b] && static_cast<std::int64_t>(e) == (label[a] ? a : b))
+        {
+          inner.emplace_back(e, k);
+        }
       }
     }
   }
-  for (std::size_t i = 0; i < adjacency.A.size() && !own; ++i)
+  else
   {
-    const std::int64_t a = adjacency.A[i], b = adjacency.B[i];
-    if (label[a] != label[b])
+    for (std::size_t i = 0; i < adjacency.A.size(); ++i)
     {
-      inner.emplace_back(label[a] ? a : b, label[a] ? adjacency.LocalA[i] : adjacency.LocalB[i]);
+      const std::int64_t a = adjacency.A[i], b = adjacency.B[i];
+      if (label[a] != label[b])
+      {
+        inner.emplace_back(label[a] ? a : b, label[a] ? adjacency.LocalA[i] : adjacency.LocalB[i]);
+      }
     }
   }
   for (std::size_t h = 0; h < adjacency.HullElement.size(); ++h)

@@ -199,7 +199,11 @@ void BandElements(const VoxelRefinementProblem& p, const FaceAdjacency& faces, s
   const auto other = [&](std::int64_t e, std::int32_t f) { return faces.A[f] == e ? faces.B[f] : faces.A[f]; };
   for (std::int64_t e = 0; e < n; ++e)
   {
-    for (int k = 0; k < vpc && label[e]; ++k)
+    if (!label[e])
+    {
+      continue;
+    }
+    for (int k = 0; k < vpc; ++k)
     {
       const std::int32_t f = faceOf[e * vpc + k];
       if (f >= 0 && label[other(e, f)] != label[e])
@@ -213,7 +217,11 @@ void BandElements(const VoxelRefinementProblem& p, const FaceAdjacency& faces, s
     std::vector<std::uint8_t> grown = band;
     for (std::int64_t e = 0; e < n; ++e)
     {
-      for (int k = 0; k < vpc && band[e]; ++k)
+      if (!band[e])
+      {
+        continue;
+      }
+      for (int k = 0; k < vpc; ++k)
       {
         const std::int32_t f = faceOf[e * vpc + k];
         if (f >= 0)
@@ -727,11 +735,16 @@ std::vector<double> ComponentChanges(const VoxelRefinementProblem& p, const Voxe
   std::vector<std::uint8_t> mark(faces.A.size(), 0);
   for (std::size_t e = 0; e < label.size(); ++e)
   {
-    for (int k = 0; k < vpc && inside(static_cast<std::int64_t>(e)); ++k)
+    if (!inside(static_cast<std::int64_t>(e)))
     {
-      if (faceOf[e * vpc + k] >= 0)
+      continue;
+    }
+    for (int k = 0; k < vpc; ++k)
+    {
+      const std::int32_t f = faceOf[e * vpc + k];
+      if (f >= 0)
       {
-        mark[faceOf[e * vpc + k]] = 1;
+        mark[f] = 1;
       }
     }
   }
